@@ -1,0 +1,186 @@
+//! The `sppm` command line: a thin caller of the library.
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use sppm::run::{estimated_memory, prepare, RunOptions};
+use sppm::Scene;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "sppm",
+    version,
+    about = "Peridynamic lattice (SPLM) and particle (SPPM) models of concrete fracture"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scene and write its outputs to output/<scene>/ (or --out).
+    Run {
+        scene: PathBuf,
+        /// Output folder (default: output/<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override a scene value, e.g. --set material.E=3.0e10 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// No progress bar and no report on stdout.
+        #[arg(long)]
+        quiet: bool,
+        /// Worker threads (default: the scene's solver.threads, else all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Validate a scene and print its size, time step, steps, memory and run time estimates.
+    Check {
+        scene: PathBuf,
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
+    /// Throughput of the step kernel on a square hexagonal-lattice block (one JSON line).
+    Bench {
+        /// Dimension (2; 3D arrives with the FCC lattice).
+        #[arg(long, default_value_t = 2)]
+        dim: usize,
+        #[arg(long, default_value_t = 100_000)]
+        particles: usize,
+        #[arg(long, default_value_t = 200)]
+        steps: usize,
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        /// Kernel: elastic (damage kernels arrive with the concrete model).
+        #[arg(long, default_value = "elastic")]
+        model: String,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        Command::Run {
+            scene,
+            out,
+            set,
+            quiet,
+            threads,
+        } => {
+            let sc = Scene::from_file(&scene, &set)?;
+            let dir = out.unwrap_or_else(|| PathBuf::from("output").join(sc.name()));
+            let outcome = sppm::run(
+                &sc,
+                &RunOptions {
+                    progress: !quiet,
+                    threads,
+                },
+            )?;
+            let files = sppm::output::write_all(&outcome, &dir)?;
+            let s = &outcome.summary;
+            if !quiet {
+                println!(
+                    "{}: {} particles, {} bonds, {} steps of {:.4e} s (T1 = {:.4e} s) in {:.2} s on {} threads",
+                    s.scene, s.particles, s.bonds, s.steps, s.dt_s, s.fundamental_period_s, s.wall_time_s, s.threads
+                );
+                println!(
+                    "peak force {:.6e} N at {:.6e} m; max kinetic/internal energy {:.3e}",
+                    s.peak_force_n, s.displacement_at_peak_m, s.max_kinetic_to_internal_energy
+                );
+                for f in &files {
+                    println!("wrote {}", f.display());
+                }
+            }
+            if outcome.failed() {
+                eprintln!("error: {}", s.message.clone().unwrap_or_default());
+                return Ok(ExitCode::from(3));
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Check { scene, set } => {
+            let sc = Scene::from_file(&scene, &set)?;
+            let mem = estimated_memory(&sc);
+            let p = prepare(&sc)?;
+            // calibrate the run time with a few steps of the real kernel
+            let probe = sppm::solver::Integration {
+                dt: p.dt,
+                lagged_forces: sc.solver.force_lag == sppm::scene::ForceLag::Previous,
+                ramp: sc.loading.ramp,
+                t_ramp: sc.loading.ramp_fraction * p.t_end,
+            };
+            let mut sim = sppm::solver::Simulation::new(
+                p.particles.x0.clone(),
+                p.mech.clone(),
+                p.prescribed.clone(),
+                probe,
+            );
+            let calib = 20.min(p.steps.max(1));
+            let t = std::time::Instant::now();
+            for _ in 0..calib {
+                sim.advance(None);
+            }
+            let per_step = t.elapsed().as_secs_f64() / calib as f64;
+            println!("scene            {}", sc.name());
+            println!("particles        {}", p.particles.len());
+            println!("bonds            {}", p.particles.bonds());
+            println!(
+                "groups           {}",
+                p.groups
+                    .iter()
+                    .map(|g| format!("{} ({})", g.name, g.members.len()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            println!("fundamental T1   {:.6e} s", p.fundamental.period);
+            println!("stable dt        {:.6e} s", p.stable.dt_stable);
+            println!("time step dt     {:.6e} s", p.dt);
+            println!("t_end            {:.6e} s", p.t_end);
+            println!("steps            {}", p.steps);
+            println!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+            println!(
+                "run time (est.)  {:.1} s on {} threads",
+                per_step * p.steps as f64,
+                rayon::current_num_threads()
+            );
+            println!(
+                "surface corr.    {} of {} boundary particles",
+                p.surface.corrected, p.surface.boundary_particles
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Bench {
+            dim,
+            particles,
+            steps,
+            threads,
+            model,
+        } => {
+            anyhow::ensure!(
+                dim == 2,
+                "--dim {dim}: only 2 is available (3D arrives with the FCC lattice)"
+            );
+            anyhow::ensure!(
+                model == "elastic",
+                "--model {model}: only \"elastic\" is available until the damage kernels land"
+            );
+            anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
+            anyhow::ensure!(threads >= 1, "--threads {threads}: at least 1");
+            let r = sppm::bench::bench_elastic(particles, steps.max(1), threads)
+                .context("benchmark failed")?;
+            println!("{}", serde_json::to_string(&r)?);
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}

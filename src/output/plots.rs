@@ -1,0 +1,202 @@
+//! SVG plots with plotters: the force–displacement curve (kN against mm) and the particle
+//! map coloured by a field, optionally on the magnified deformed shape.
+
+use super::fields;
+use crate::run::Outcome;
+use crate::scene::Field;
+use plotters::prelude::*;
+use std::path::Path;
+
+fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow::anyhow!("plotting failed: {e}")
+}
+
+/// Viridis colour map, t in [0, 1].
+pub fn viridis(t: f64) -> RGBColor {
+    const ANCHORS: [(f64, f64, f64); 6] = [
+        (68.0, 1.0, 84.0),
+        (65.0, 68.0, 135.0),
+        (42.0, 120.0, 142.0),
+        (34.0, 168.0, 132.0),
+        (122.0, 209.0, 81.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (ANCHORS.len() - 1) as f64;
+    let k = (x.floor() as usize).min(ANCHORS.len() - 2);
+    let f = x - k as f64;
+    let (a, b) = (ANCHORS[k], ANCHORS[k + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * f).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// force_displacement.svg: reaction of the probe group (kN) against its displacement (mm).
+pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
+    let pts: Vec<(f64, f64)> = o
+        .records
+        .iter()
+        .map(|r| (r.displacement_m * 1e3, r.force_n * 1e-3))
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for &(x, y) in &pts {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let pad = |a: f64, b: f64| {
+        let d = (b - a).abs().max(1e-12) * 0.05;
+        (a - d, b + d)
+    };
+    let (x0, x1) = pad(x0, x1);
+    let (y0, y1) = pad(y0, y1);
+    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let group = o.summary.probe_group.clone().unwrap_or_else(|| "-".into());
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("{}: force–displacement", o.summary.scene),
+            ("sans-serif", 22),
+        )
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(format!("displacement of group '{group}' (mm)"))
+        .y_desc("reaction force (kN)")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(pts.iter().copied(), BLUE.stroke_width(2)))
+        .map_err(err)?;
+    if o.summary.peak_force_n != 0.0 {
+        let sign = if o.records.iter().any(|r| r.displacement_m < 0.0) {
+            -1.0
+        } else {
+            1.0
+        };
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (
+                    o.summary.displacement_at_peak_m * 1e3,
+                    sign * o.summary.peak_force_n * 1e-3,
+                ),
+                5,
+                RED.filled(),
+            )))
+            .map_err(err)?
+            .label(format!("peak {:.4} kN", o.summary.peak_force_n * 1e-3))
+            .legend(|(x, y)| Circle::new((x, y), 5, RED.filled()));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(err)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// particle_map.svg: every particle as a disc coloured by `field`, at x0 + scale·u.
+pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyhow::Result<()> {
+    let values = fields::values(o, field);
+    let pos: Vec<(f64, f64)> =
+        o.x0.iter()
+            .zip(&o.displacement)
+            .map(|(x, u)| ((x.x + scale * u.x) * 1e3, (x.y + scale * u.y) * 1e3))
+            .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in &pos {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let l0 = o.summary.spacing_m * 1e3;
+    let (x0, x1, y0, y1) = (x0 - l0, x1 + l0, y0 - l0, y1 + l0);
+    let (vmin, vmax) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let span = if vmax > vmin { vmax - vmin } else { 1.0 };
+    // plot area sized to the body's aspect ratio
+    let plot_w = 700.0;
+    let plot_h = (plot_w * (y1 - y0) / (x1 - x0)).clamp(150.0, 1400.0);
+    let width = plot_w as u32 + 230;
+    let height = plot_h as u32 + 110;
+    let root = SVGBackend::new(path, (width, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let (main, bar) = root.split_horizontally(width - 140);
+    let title = if scale > 0.0 {
+        format!(
+            "{}: {} (deformed ×{scale})",
+            o.summary.scene,
+            fields::label(field)
+        )
+    } else {
+        format!("{}: {}", o.summary.scene, fields::label(field))
+    };
+    let mut chart = ChartBuilder::on(&main)
+        .caption(title, ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x (mm)")
+        .y_desc("y (mm)")
+        .draw()
+        .map_err(err)?;
+    let px_per_mm = plot_w / (x1 - x0);
+    let radius = ((0.5 * l0 * px_per_mm).round() as i32).max(1);
+    chart
+        .draw_series(
+            pos.iter()
+                .zip(&values)
+                .map(|(&p, &v)| Circle::new(p, radius, viridis((v - vmin) / span).filled())),
+        )
+        .map_err(err)?;
+    // colour bar
+    let mut cb = ChartBuilder::on(&bar)
+        .margin_top(40)
+        .margin_bottom(60)
+        .margin_right(10)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, vmin..(vmin + span))
+        .map_err(err)?;
+    cb.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(8)
+        .draw()
+        .map_err(err)?;
+    let steps = 100;
+    cb.draw_series((0..steps).map(|k| {
+        let a = vmin + span * k as f64 / steps as f64;
+        let b = vmin + span * (k + 1) as f64 / steps as f64;
+        Rectangle::new(
+            [(0.0, a), (1.0, b)],
+            viridis((k as f64 + 0.5) / steps as f64).filled(),
+        )
+    }))
+    .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}

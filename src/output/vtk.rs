@@ -1,0 +1,82 @@
+//! Legacy binary VTK (POLYDATA, one vertex per particle) for ParaView, with displacement,
+//! stress, von Mises stress, bond count and group membership as point data.
+
+use super::fields;
+use crate::run::Outcome;
+use crate::scene::Field;
+use anyhow::Context;
+use std::io::Write;
+use std::path::Path;
+
+fn be(w: &mut impl Write, v: f64) -> std::io::Result<()> {
+    w.write_all(&(v as f32).to_be_bytes())
+}
+
+pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
+    let f =
+        std::fs::File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
+    let mut w = std::io::BufWriter::new(f);
+    let n = o.x0.len();
+    writeln!(w, "# vtk DataFile Version 3.0")?;
+    writeln!(w, "sppm {} particles", o.summary.scene)?;
+    writeln!(w, "BINARY\nDATASET POLYDATA\nPOINTS {n} float")?;
+    for x in &o.x0 {
+        be(&mut w, x.x)?;
+        be(&mut w, x.y)?;
+        be(&mut w, 0.0)?;
+    }
+    writeln!(w, "\nVERTICES {n} {}", 2 * n)?;
+    for i in 0..n {
+        w.write_all(&1i32.to_be_bytes())?;
+        w.write_all(&(i as i32).to_be_bytes())?;
+    }
+    writeln!(w, "\nPOINT_DATA {n}\nVECTORS displacement_m float")?;
+    for u in &o.displacement {
+        be(&mut w, u.x)?;
+        be(&mut w, u.y)?;
+        be(&mut w, 0.0)?;
+    }
+    writeln!(w, "\nTENSORS stress_Pa float")?;
+    for s in &o.stress {
+        for v in [
+            s[(0, 0)],
+            s[(0, 1)],
+            0.0,
+            s[(1, 0)],
+            s[(1, 1)],
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ] {
+            be(&mut w, v)?;
+        }
+    }
+    for (name, field) in [
+        ("von_mises_MPa", Field::StressVonMises),
+        ("max_principal_MPa", Field::MaxPrincipalStress),
+    ] {
+        writeln!(w, "\nSCALARS {name} float 1\nLOOKUP_TABLE default")?;
+        for v in fields::values(o, field) {
+            be(&mut w, v)?;
+        }
+    }
+    for g in &o.groups {
+        let mut member = vec![0.0; n];
+        for &i in &g.members {
+            member[i as usize] = 1.0;
+        }
+        let name: String = g
+            .name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        writeln!(w, "\nSCALARS group_{name} float 1\nLOOKUP_TABLE default")?;
+        for v in member {
+            be(&mut w, v)?;
+        }
+    }
+    writeln!(w)?;
+    w.flush()?;
+    Ok(())
+}

@@ -1,0 +1,560 @@
+//! `run(scene) -> Outcome`: the whole pipeline of one specimen (ARCHITECTURE.md): scene →
+//! body → lattice and groups → micro-moduli → model → stable step and fundamental period →
+//! explicit run with probes → outcome. The CLI and the studies are thin callers.
+
+use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
+use crate::material;
+use crate::model::micro_modulus::{self, MicroModuli};
+use crate::model::stress::StressSum;
+use crate::scene::{Scene, SceneError};
+use crate::solver::loading::Prescribed;
+use crate::solver::mechanics::Mechanics;
+use crate::solver::time_step::{stable_step, StableStep};
+use crate::solver::{modal, Integration, Probe, Record, Simulation};
+use nalgebra::{Matrix2, Vector2};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Everything that stops a run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error("{0}")]
+    Setup(String),
+    #[error(transparent)]
+    Modal(#[from] modal::ModalError),
+}
+
+/// Run options that are not part of the scene.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Show a progress bar on runs longer than about a second.
+    pub progress: bool,
+    /// Override the scene's thread count.
+    pub threads: Option<usize>,
+}
+
+/// Statistics of the surface correction (MODEL.md §3).
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceCorrection {
+    pub enabled: bool,
+    /// Particles with fewer than six bonds.
+    pub boundary_particles: usize,
+    /// Boundary particles given fitted constants.
+    pub corrected: usize,
+    /// Boundary particles whose bonds cannot carry a fit (kept at bulk constants).
+    pub kept_bulk: usize,
+    /// Largest ‖a·A + b·B − D‖/‖D‖ among the corrected particles.
+    pub max_residual: f64,
+}
+
+/// A discretised, assembled specimen ready to run.
+pub struct Prepared {
+    pub scene: Scene,
+    pub particles: Particles<2, 6>,
+    pub groups: Vec<groups::Group>,
+    pub prescribed: Vec<Prescribed>,
+    pub constrained: Vec<[bool; 2]>,
+    pub mech: Mechanics<2, 6>,
+    pub bulk: MicroModuli,
+    pub surface: SurfaceCorrection,
+    pub fundamental: modal::Fundamental,
+    pub stable: StableStep,
+    pub dt: f64,
+    pub t_end: f64,
+    pub steps: usize,
+    pub probe: Option<(String, Probe)>,
+}
+
+/// Available memory of this machine in bytes (MemAvailable), if known.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Particles the body will hold (area / cell area), known before anything is allocated.
+pub fn estimated_particles(scene: &Scene) -> f64 {
+    let l0 = scene.discretisation.spacing;
+    scene.shape().area() / (0.5 * 3f64.sqrt() * l0 * l0)
+}
+
+/// Estimated bytes a run allocates.
+pub fn estimated_memory(scene: &Scene) -> f64 {
+    estimated_particles(scene) * bytes_per_particle(2, 6) as f64
+}
+
+/// Discretise and assemble a scene, compute T1 and the time step.
+pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
+    let d = &scene.discretisation;
+    let m = &scene.material;
+    let need = estimated_memory(scene);
+    if let Some(avail) = available_memory() {
+        if need > 0.8 * avail as f64 {
+            return Err(RunError::Setup(format!(
+                "discretisation.spacing = {}: the body would hold about {:.3e} particles needing about {:.1} GiB, more than this machine has available ({:.1} GiB); use a larger spacing",
+                d.spacing,
+                estimated_particles(scene),
+                need / 2f64.powi(30),
+                avail as f64 / 2f64.powi(30)
+            )));
+        }
+    }
+    if estimated_particles(scene) > u32::MAX as f64 / 2.0 {
+        return Err(RunError::Setup(format!(
+            "discretisation.spacing = {}: about {:.3e} particles, more than the 2.1e9 a run can index",
+            d.spacing,
+            estimated_particles(scene)
+        )));
+    }
+    let shape = scene.shape();
+    let lattice = HexLattice {
+        spacing: d.spacing,
+        rotation_deg: d.rotation_deg,
+        offset: Vector2::new(d.offset[0], d.offset[1]),
+        thickness: m.thickness,
+    };
+    let particles = lattice.fill(&shape);
+    if particles.len() < 2 {
+        return Err(RunError::Setup(format!(
+            "discretisation.spacing = {}: the body holds {} bonded particles at this spacing, rotation and offset; at least 2 are needed (use a smaller spacing)",
+            d.spacing,
+            particles.len()
+        )));
+    }
+
+    // Groups, supports and loading.
+    let n = particles.len();
+    let mut groups = Vec::new();
+    let mut constrained = vec![[false; 2]; n];
+    let mut amplitude: Vec<[Option<(f64, String)>; 2]> = vec![[None, None]; n];
+    for g in &scene.groups {
+        let members = groups::select(&g.select, &particles, &shape);
+        if members.is_empty() {
+            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                key: format!("groups.{}.select", g.name),
+                value: format!("{:?}", g.select),
+                allowed: "a selection that contains at least one particle".into(),
+            }));
+        }
+        let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
+        if let Some(l) = &g.load {
+            entries.push((l.component.index(), l.displacement));
+        }
+        for &i in &members {
+            for &(c, amp) in &entries {
+                let slot = &mut amplitude[i as usize][c];
+                match slot {
+                    Some((prev, other)) if *prev != amp => {
+                        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                            key: format!("groups.{}", g.name),
+                            value: format!("particle {i} at {:?}", particles.x0[i as usize].as_slice()),
+                            allowed: format!(
+                                "groups that overlap must prescribe the same displacement: groups.{other} already prescribes {prev} m in component {c}, this group {amp} m"
+                            ),
+                        }))
+                    }
+                    _ => *slot = Some((amp, g.name.clone())),
+                }
+                constrained[i as usize][c] = true;
+            }
+        }
+        groups.push(groups::Group {
+            name: g.name.clone(),
+            members,
+        });
+    }
+    let prescribed: Vec<Prescribed> = (0..n)
+        .flat_map(|i| {
+            let a = amplitude[i].clone();
+            (0..2).filter_map(move |c| {
+                a[c].as_ref().map(|(amp, _)| Prescribed {
+                    particle: i as u32,
+                    component: c as u8,
+                    amplitude: *amp,
+                })
+            })
+        })
+        .collect();
+
+    // Micro-moduli, with the surface correction of particles that miss bonds.
+    let bulk = micro_modulus::hexagonal(m.e, m.nu, d.spacing, m.thickness, m.plane);
+    let dmat = micro_modulus::elasticity_matrix(m.e, m.nu, m.plane);
+    let mut a = vec![bulk.a; n];
+    let mut b = vec![bulk.b; n];
+    let mut surface = SurfaceCorrection {
+        enabled: d.surface_correction,
+        boundary_particles: 0,
+        corrected: 0,
+        kept_bulk: 0,
+        max_residual: 0.0,
+    };
+    for i in 0..n {
+        if particles.bond_count(i) == 6 {
+            continue;
+        }
+        surface.boundary_particles += 1;
+        if !d.surface_correction {
+            continue;
+        }
+        let bonds: Vec<(Vector2<f64>, f64)> = (0..6)
+            .filter(|&k| particles.neighbours[i][k] != crate::discretise::NONE)
+            .map(|k| {
+                let j = particles.neighbours[i][k] as usize;
+                (
+                    (particles.x0[j] - particles.x0[i]).normalize(),
+                    particles.l0[i][k],
+                )
+            })
+            .collect();
+        match micro_modulus::fit(&bonds, particles.volume[i], &dmat) {
+            Some(f) => {
+                a[i] = f.moduli.a;
+                b[i] = f.moduli.b;
+                surface.corrected += 1;
+                surface.max_residual = surface.max_residual.max(f.residual);
+            }
+            None => surface.kept_bulk += 1,
+        }
+    }
+    let rho = vec![m.rho; n];
+    let mut mech = Mechanics::new(&particles, a, b, &rho);
+
+    let fundamental = modal::fundamental(&mech, &particles.x0, &constrained)?;
+    let omega_i = material::particle_frequency(m.e, m.nu, m.rho, d.spacing);
+    let omega_struct = 2.0 * std::f64::consts::PI / fundamental.period;
+    for i in 0..n {
+        mech.c_in[i] = 2.0 * mech.mass[i] * scene.damping.internal * omega_i;
+        mech.c_ex[i] = 2.0 * mech.mass[i] * scene.damping.external * omega_struct;
+    }
+    let stable = stable_step(&mech, &particles.x0);
+    let dt = match scene.solver.dt {
+        Some(dt) if dt > stable.dt_stable => {
+            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                key: "solver.dt".into(),
+                value: format!("{dt:e}"),
+                allowed: format!(
+                    "at most the stable limit {:.6e} s computed from the stiffness, masses and damping (or leave solver.dt out to use solver.safety × the limit)",
+                    stable.dt_stable
+                ),
+            }))
+        }
+        Some(dt) => dt,
+        None => scene.solver.safety * stable.dt_stable,
+    };
+    let t_end = match (scene.loading.end_periods, scene.loading.end_s) {
+        (Some(p), _) => p * fundamental.period,
+        (None, Some(s)) => s,
+        (None, None) => 10.0 * fundamental.period,
+    };
+    let steps = (t_end / dt).ceil() as usize;
+    if steps as f64 * n as f64 > 1e14 {
+        return Err(RunError::Setup(format!(
+            "loading: t_end = {t_end:.3e} s needs {steps} steps of {n} particles, beyond 1e14 particle-steps; shorten loading.end_periods or coarsen discretisation.spacing"
+        )));
+    }
+
+    let probe_name = scene.output.probe_group.clone().or_else(|| {
+        scene
+            .groups
+            .iter()
+            .find(|g| g.load.is_some())
+            .map(|g| g.name.clone())
+    });
+    let probe = probe_name.map(|name| {
+        let spec = scene.groups.iter().find(|g| g.name == name).unwrap();
+        let members = groups
+            .iter()
+            .find(|g| g.name == name)
+            .unwrap()
+            .members
+            .clone();
+        let (component, amplitude) = match &spec.load {
+            Some(l) => (l.component.index(), l.displacement),
+            None => (spec.fix[0].index(), 0.0),
+        };
+        (
+            name,
+            Probe {
+                members,
+                component,
+                amplitude,
+            },
+        )
+    });
+
+    Ok(Prepared {
+        scene: scene.clone(),
+        particles,
+        groups,
+        prescribed,
+        constrained,
+        mech,
+        bulk,
+        surface,
+        fundamental,
+        stable,
+        dt,
+        t_end,
+        steps,
+        probe,
+    })
+}
+
+/// The summary of a run (summary.json; the keys ARCHITECTURE.md names, and more).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub scene: String,
+    pub description: Option<String>,
+    pub status: String,
+    pub message: Option<String>,
+    pub particles: usize,
+    pub bonds: usize,
+    pub steps: usize,
+    pub dt_s: f64,
+    pub dt_stable_s: f64,
+    pub safety: f64,
+    pub fundamental_period_s: f64,
+    pub t_end_s: f64,
+    pub wall_time_s: f64,
+    pub threads: usize,
+    pub probe_group: Option<String>,
+    #[serde(rename = "peak_force_N")]
+    pub peak_force_n: f64,
+    pub displacement_at_peak_m: f64,
+    pub final_displacement_m: f64,
+    #[serde(rename = "final_force_N")]
+    pub final_force_n: f64,
+    /// External work not found in kinetic, elastic or damper energy (damage and plasticity;
+    /// for an elastic scene a measure of the energy error).
+    #[serde(rename = "dissipated_energy_J")]
+    pub dissipated_energy_j: f64,
+    #[serde(rename = "damping_energy_J")]
+    pub damping_energy_j: f64,
+    #[serde(rename = "external_work_J")]
+    pub external_work_j: f64,
+    #[serde(rename = "internal_energy_J")]
+    pub internal_energy_j: f64,
+    #[serde(rename = "kinetic_energy_J")]
+    pub kinetic_energy_j: f64,
+    /// Largest kinetic/internal energy ratio over the records where the internal energy is at
+    /// least 1% of its maximum (the quasi-static check).
+    pub max_kinetic_to_internal_energy: f64,
+    pub force_lag: crate::scene::ForceLag,
+    pub surface_correction: SurfaceCorrection,
+    pub micro_modulus_a_bulk: f64,
+    pub micro_modulus_b_bulk: f64,
+    pub spacing_m: f64,
+    pub rotation_deg: f64,
+    pub offset_m: [f64; 2],
+    pub omega_max_bound_rad_s: f64,
+    /// No random choice is made by the elastic lattice; recorded for reproducibility.
+    pub seed: Option<u64>,
+    pub sppm_version: String,
+}
+
+/// What a run produces.
+pub struct Outcome {
+    pub summary: Summary,
+    pub records: Vec<Record>,
+    pub x0: Vec<Vector2<f64>>,
+    pub displacement: Vec<Vector2<f64>>,
+    pub stress: Vec<Matrix2<f64>>,
+    pub groups: Vec<groups::Group>,
+    pub scene: Scene,
+}
+
+impl Outcome {
+    pub fn failed(&self) -> bool {
+        self.summary.status != "completed"
+    }
+}
+
+/// Particle stresses (3.18) at positions x.
+pub fn particle_stress(p: &Prepared, x: &[Vector2<f64>]) -> Vec<Matrix2<f64>> {
+    let mech = &p.mech;
+    (0..x.len())
+        .map(|i| {
+            let mut theta = 0.0;
+            for (_, j, il) in mech.bonds(i) {
+                theta += (x[j] - x[i]).norm() * il - 1.0;
+            }
+            let mut acc = StressSum::default();
+            for (_, j, il) in mech.bonds(i) {
+                let d = x[j] - x[i];
+                let len = d.norm();
+                let s = len * il - 1.0;
+                acc.add(&(d / len), 1.0 / il, mech.a[i] * s + mech.b[i] * theta);
+            }
+            acc.finish(p.particles.volume[i])
+        })
+        .collect()
+}
+
+/// Run a scene to its end. A run that goes unstable stops there and its outcome says so
+/// (`summary.status = "unstable"`, `summary.message` names the step and the particle).
+pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
+    let threads = opts
+        .threads
+        .or(scene.solver.threads)
+        .unwrap_or_else(rayon::current_num_threads);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| RunError::Setup(format!("cannot start {threads} threads: {e}")))?;
+    pool.install(|| run_prepared(prepare(scene)?, opts, threads))
+}
+
+fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
+    let start = Instant::now();
+    let integration = Integration {
+        dt: p.dt,
+        lagged_forces: p.scene.solver.force_lag == crate::scene::ForceLag::Previous,
+        ramp: p.scene.loading.ramp,
+        t_ramp: p.scene.loading.ramp_fraction * p.t_end,
+    };
+    let mut sim = Simulation::new(
+        p.particles.x0.clone(),
+        p.mech.clone(),
+        p.prescribed.clone(),
+        integration,
+    );
+    let every = (p.steps / (p.scene.output.records - 1)).max(1);
+    let bar = if opts.progress && (p.steps as f64 * p.particles.len() as f64) > 2e7 {
+        let b = indicatif::ProgressBar::new(p.steps as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} {wide_bar} {pos}/{len} steps  {elapsed_precise} ETA {eta}",
+            )
+            .unwrap(),
+        );
+        Some(b)
+    } else {
+        None
+    };
+    let empty_probe = Probe {
+        members: vec![],
+        component: 1,
+        amplitude: 0.0,
+    };
+    let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
+    let mut records = Vec::with_capacity(p.scene.output.records + 1);
+    let mut failure = None;
+    for n in 0..p.steps {
+        let want = n % every == 0 || n + 1 == p.steps;
+        let rec = sim.advance(if want { Some(probe) } else { None });
+        if let Some(r) = rec {
+            records.push(r);
+        }
+        if want || n % 64 == 0 {
+            let u = rec.map(|r| r.internal_j);
+            if let Err(e) = sim.check_stability(u) {
+                failure = Some(e);
+                break;
+            }
+        }
+        if let Some(b) = &bar {
+            if n % 256 == 0 {
+                b.set_position(n as u64);
+            }
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let wall = start.elapsed().as_secs_f64();
+    let x = sim.state.x.clone();
+    let displacement: Vec<Vector2<f64>> =
+        x.iter().zip(&p.particles.x0).map(|(a, b)| a - b).collect();
+    let stress = particle_stress(&p, &x);
+    let summary = summarise(
+        &p,
+        &records,
+        wall,
+        threads,
+        failure.as_ref().map(|e| e.to_string()),
+    );
+    let outcome = Outcome {
+        summary,
+        records,
+        x0: p.particles.x0.clone(),
+        displacement,
+        stress,
+        groups: p.groups.clone(),
+        scene: p.scene.clone(),
+    };
+    Ok(outcome)
+}
+
+fn summarise(
+    p: &Prepared,
+    records: &[Record],
+    wall: f64,
+    threads: usize,
+    failure: Option<String>,
+) -> Summary {
+    let sign = p
+        .probe
+        .as_ref()
+        .map(|(_, pr)| if pr.amplitude < 0.0 { -1.0 } else { 1.0 })
+        .unwrap_or(1.0);
+    let peak = records.iter().max_by(|a, b| {
+        (sign * a.force_n)
+            .partial_cmp(&(sign * b.force_n))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    let last = records.last().copied().unwrap_or_default();
+    let umax = records.iter().map(|r| r.internal_j).fold(0.0, f64::max);
+    let ratio = records
+        .iter()
+        .filter(|r| r.internal_j >= 0.01 * umax && umax > 0.0)
+        .map(|r| r.kinetic_j / r.internal_j)
+        .fold(0.0, f64::max);
+    let d = &p.scene.discretisation;
+    Summary {
+        scene: p.scene.name().to_string(),
+        description: p.scene.description.clone(),
+        status: if failure.is_some() {
+            "unstable".into()
+        } else {
+            "completed".into()
+        },
+        message: failure,
+        particles: p.particles.len(),
+        bonds: p.particles.bonds(),
+        steps: records.last().map(|r| r.step + 1).unwrap_or(0),
+        dt_s: p.dt,
+        dt_stable_s: p.stable.dt_stable,
+        safety: p.dt / p.stable.dt_stable,
+        fundamental_period_s: p.fundamental.period,
+        t_end_s: p.t_end,
+        wall_time_s: wall,
+        threads,
+        probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),
+        peak_force_n: peak.map(|r| r.force_n * sign).unwrap_or(0.0),
+        displacement_at_peak_m: peak.map(|r| r.displacement_m).unwrap_or(0.0),
+        final_displacement_m: last.displacement_m,
+        final_force_n: last.force_n,
+        dissipated_energy_j: last.external_work_j
+            - last.kinetic_j
+            - last.internal_j
+            - last.damping_j,
+        damping_energy_j: last.damping_j,
+        external_work_j: last.external_work_j,
+        internal_energy_j: last.internal_j,
+        kinetic_energy_j: last.kinetic_j,
+        max_kinetic_to_internal_energy: ratio,
+        force_lag: p.scene.solver.force_lag,
+        surface_correction: p.surface.clone(),
+        micro_modulus_a_bulk: p.bulk.a,
+        micro_modulus_b_bulk: p.bulk.b,
+        spacing_m: d.spacing,
+        rotation_deg: d.rotation_deg,
+        offset_m: d.offset,
+        omega_max_bound_rad_s: p.stable.omega_max,
+        seed: None,
+        sppm_version: env!("CARGO_PKG_VERSION").to_string(),
+    }
+}

@@ -1,0 +1,415 @@
+//! Scene validation: every impossible value is refused before any work, with one message
+//! naming the key, the value and what is allowed.
+
+use super::*;
+use crate::geometry::polygon_self_intersects;
+use nalgebra::Vector2;
+use std::collections::HashSet;
+
+/// Everything that can be wrong with a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{0}")]
+    Io(String),
+    #[error("scene file is not valid: {0}")]
+    Parse(String),
+    #[error("--set {key}: {message}")]
+    Override { key: String, message: String },
+    #[error("{key} = {value}: {allowed}")]
+    Invalid {
+        key: String,
+        value: String,
+        allowed: String,
+    },
+    #[error("{file}: {inner}")]
+    InFile {
+        file: String,
+        inner: Box<SceneError>,
+    },
+}
+
+impl SceneError {
+    pub(crate) fn in_file(self, path: &std::path::Path) -> SceneError {
+        SceneError::InFile {
+            file: path.display().to_string(),
+            inner: Box::new(self),
+        }
+    }
+}
+
+pub(crate) fn invalid(
+    key: impl Into<String>,
+    value: impl std::fmt::Display,
+    allowed: impl Into<String>,
+) -> SceneError {
+    SceneError::Invalid {
+        key: key.into(),
+        value: value.to_string(),
+        allowed: allowed.into(),
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(key, v, "must be a finite number greater than zero"))
+    }
+}
+
+fn finite(key: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(key, v, "must be a finite number"))
+    }
+}
+
+impl Scene {
+    /// Check every value; the first problem found is returned.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        if let Some(n) = &self.name {
+            if n.is_empty() || n.contains(['/', '\\']) {
+                return Err(invalid(
+                    "name",
+                    format!("{n:?}"),
+                    "a non-empty name without path separators",
+                ));
+            }
+        }
+        self.validate_body()?;
+        let d = &self.discretisation;
+        if d.lattice != "hexagonal" {
+            return Err(invalid(
+                "discretisation.lattice",
+                format!("{:?}", d.lattice),
+                "\"hexagonal\" (2D SPLM); \"fcc\" and \"random\" are not available yet",
+            ));
+        }
+        positive("discretisation.spacing", d.spacing)?;
+        finite("discretisation.rotation_deg", d.rotation_deg)?;
+        finite("discretisation.offset[0]", d.offset[0])?;
+        finite("discretisation.offset[1]", d.offset[1])?;
+        let size = self.body_size();
+        if d.spacing > 0.5 * size {
+            return Err(invalid(
+                "discretisation.spacing",
+                d.spacing,
+                format!(
+                    "must be at most half the body's smallest dimension ({:.4e} m)",
+                    0.5 * size
+                ),
+            ));
+        }
+
+        let m = &self.material;
+        positive("material.E", m.e)?;
+        positive("material.rho", m.rho)?;
+        positive("material.thickness", m.thickness)?;
+        if !(m.nu.is_finite() && m.nu > -1.0 && m.nu < 0.5) {
+            return Err(invalid("material.nu", m.nu, "must satisfy -1 < nu < 0.5"));
+        }
+
+        let mut names = HashSet::new();
+        let mut any_load = false;
+        for (gi, g) in self.groups.iter().enumerate() {
+            let key = format!("groups[{gi}]");
+            if g.name.is_empty() {
+                return Err(invalid(
+                    format!("{key}.name"),
+                    "\"\"",
+                    "a non-empty group name",
+                ));
+            }
+            if !names.insert(g.name.clone()) {
+                return Err(invalid(
+                    format!("{key}.name"),
+                    format!("{:?}", g.name),
+                    "group names must be unique",
+                ));
+            }
+            let key = format!("groups.{}", g.name);
+            match &g.select {
+                Selection::Edge { rows, .. } => {
+                    if *rows == 0 || *rows > 20 {
+                        return Err(invalid(
+                            format!("{key}.select.rows"),
+                            rows,
+                            "an integer from 1 to 20",
+                        ));
+                    }
+                }
+                Selection::Strip {
+                    width,
+                    depth,
+                    centre,
+                    ..
+                } => {
+                    positive(&format!("{key}.select.width"), *width)?;
+                    finite(&format!("{key}.select.centre"), *centre)?;
+                    if let Some(dp) = depth {
+                        positive(&format!("{key}.select.depth"), *dp)?;
+                    }
+                }
+                Selection::Box { min, max } => {
+                    for c in 0..2 {
+                        finite(&format!("{key}.select.min[{c}]"), min[c])?;
+                        finite(&format!("{key}.select.max[{c}]"), max[c])?;
+                        if max[c] <= min[c] {
+                            return Err(invalid(
+                                format!("{key}.select.max[{c}]"),
+                                max[c],
+                                format!("must be greater than select.min[{c}] = {}", min[c]),
+                            ));
+                        }
+                    }
+                }
+                Selection::All => {}
+            }
+            let mut fixed = HashSet::new();
+            for a in &g.fix {
+                if !fixed.insert(a.index()) {
+                    return Err(invalid(
+                        format!("{key}.fix"),
+                        format!("{:?}", g.fix),
+                        "each axis at most once",
+                    ));
+                }
+            }
+            if let Some(l) = &g.load {
+                any_load = true;
+                finite(&format!("{key}.load.displacement"), l.displacement)?;
+                if fixed.contains(&l.component.index()) {
+                    return Err(invalid(
+                        format!("{key}.load.component"),
+                        format!("{:?}", l.component).to_lowercase(),
+                        "a component that is not also in fix",
+                    ));
+                }
+            }
+        }
+
+        let l = &self.loading;
+        if !(l.ramp_fraction > 0.0 && l.ramp_fraction <= 1.0) {
+            return Err(invalid(
+                "loading.ramp_fraction",
+                l.ramp_fraction,
+                "must satisfy 0 < ramp_fraction <= 1",
+            ));
+        }
+        match (l.end_periods, l.end_s) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "loading.end_s",
+                    l.end_s.unwrap(),
+                    "give either loading.end_periods or loading.end_s, not both",
+                ))
+            }
+            (Some(p), None) => {
+                positive("loading.end_periods", p)?;
+                if p > 1.0e5 {
+                    return Err(invalid(
+                        "loading.end_periods",
+                        p,
+                        "at most 1e5 fundamental periods",
+                    ));
+                }
+            }
+            (None, Some(s)) => positive("loading.end_s", s)?,
+            (None, None) => {
+                if any_load {
+                    return Err(invalid(
+                        "loading.end_periods",
+                        "(missing)",
+                        "a scene with a loaded group needs loading.end_periods (multiples of the computed fundamental period) or loading.end_s",
+                    ));
+                }
+            }
+        }
+
+        for (k, v) in [
+            ("damping.internal", self.damping.internal),
+            ("damping.external", self.damping.external),
+        ] {
+            if !(v.is_finite() && (0.0..=10.0).contains(&v)) {
+                return Err(invalid(k, v, "a damping ratio from 0 to 10"));
+            }
+        }
+
+        let s = &self.solver;
+        if !(s.safety > 0.0 && s.safety <= 1.0) {
+            return Err(invalid(
+                "solver.safety",
+                s.safety,
+                "must satisfy 0 < safety <= 1 (a fraction of the stable time step)",
+            ));
+        }
+        if let Some(dt) = s.dt {
+            positive("solver.dt", dt)?;
+        }
+        if let Some(t) = s.threads {
+            if t == 0 || t > 1024 {
+                return Err(invalid("solver.threads", t, "an integer from 1 to 1024"));
+            }
+        }
+
+        let o = &self.output;
+        if o.records < 2 || o.records > 1_000_000 {
+            return Err(invalid(
+                "output.records",
+                o.records,
+                "an integer from 2 to 1000000",
+            ));
+        }
+        if let Some(p) = &o.probe_group {
+            match self.groups.iter().find(|g| &g.name == p) {
+                None => {
+                    let known: Vec<_> = self.groups.iter().map(|g| g.name.as_str()).collect();
+                    return Err(invalid(
+                        "output.probe_group",
+                        format!("{p:?}"),
+                        format!("one of the groups: {known:?}"),
+                    ));
+                }
+                Some(g) if g.load.is_none() && g.fix.is_empty() => {
+                    return Err(invalid(
+                        "output.probe_group",
+                        format!("{p:?}"),
+                        "a group that is loaded or fixed (it has a reaction)",
+                    ));
+                }
+                _ => {}
+            }
+        }
+        if !(o.deformed_scale.is_finite() && o.deformed_scale >= 0.0) {
+            return Err(invalid(
+                "output.deformed_scale",
+                o.deformed_scale,
+                "a magnification >= 0 (0 draws the reference shape)",
+            ));
+        }
+        Ok(())
+    }
+
+    fn validate_body(&self) -> Result<(), SceneError> {
+        match &self.body {
+            BodySpec::Rectangle {
+                width,
+                height,
+                origin,
+            } => {
+                positive("body.width", *width)?;
+                positive("body.height", *height)?;
+                finite("body.origin[0]", origin[0])?;
+                finite("body.origin[1]", origin[1])?;
+            }
+            BodySpec::Polygon { vertices } => {
+                if vertices.len() < 3 {
+                    return Err(invalid(
+                        "body.vertices",
+                        format!("{} vertices", vertices.len()),
+                        "at least 3 vertices",
+                    ));
+                }
+                for (i, v) in vertices.iter().enumerate() {
+                    finite(&format!("body.vertices[{i}][0]"), v[0])?;
+                    finite(&format!("body.vertices[{i}][1]"), v[1])?;
+                }
+                let pts: Vec<_> = vertices.iter().map(|v| Vector2::new(v[0], v[1])).collect();
+                if crate::geometry::polygon_area(&pts).abs() <= 0.0 {
+                    return Err(invalid(
+                        "body.vertices",
+                        format!("{vertices:?}"),
+                        "a polygon with non-zero area",
+                    ));
+                }
+                if polygon_self_intersects(&pts) {
+                    return Err(invalid(
+                        "body.vertices",
+                        format!("{vertices:?}"),
+                        "a simple polygon (its edges must not cross)",
+                    ));
+                }
+            }
+            BodySpec::Disc { diameter, centre } => {
+                positive("body.diameter", *diameter)?;
+                finite("body.centre[0]", centre[0])?;
+                finite("body.centre[1]", centre[1])?;
+            }
+            BodySpec::Dogbone { size } => positive("body.size", *size)?,
+            BodySpec::NotchedBeam {
+                length,
+                depth,
+                notch_depth,
+                notch_width,
+            } => {
+                positive("body.length", *length)?;
+                positive("body.depth", *depth)?;
+                if !(notch_depth.is_finite() && *notch_depth >= 0.0 && notch_depth < depth) {
+                    return Err(invalid(
+                        "body.notch_depth",
+                        notch_depth,
+                        format!("0 <= notch_depth < depth ({depth})"),
+                    ));
+                }
+                if !(notch_width.is_finite() && *notch_width >= 0.0 && notch_width < length) {
+                    return Err(invalid(
+                        "body.notch_width",
+                        notch_width,
+                        format!("0 <= notch_width < length ({length})"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The body's smallest overall dimension (m).
+    pub fn body_size(&self) -> f64 {
+        match &self.body {
+            BodySpec::Rectangle { width, height, .. } => width.min(*height),
+            BodySpec::Polygon { .. } => {
+                let (lo, hi) = self.shape().bounding_box();
+                (hi - lo).min()
+            }
+            BodySpec::Disc { diameter, .. } => *diameter,
+            BodySpec::Dogbone { size } => 0.6 * size,
+            BodySpec::NotchedBeam { length, depth, .. } => length.min(*depth),
+        }
+    }
+
+    /// The geometric shape of the body.
+    pub fn shape(&self) -> crate::geometry::Shape2 {
+        use crate::geometry::Shape2;
+        match &self.body {
+            BodySpec::Rectangle {
+                width,
+                height,
+                origin,
+            } => Shape2::Rectangle {
+                origin: Vector2::new(origin[0], origin[1]),
+                width: *width,
+                height: *height,
+            },
+            BodySpec::Polygon { vertices } => Shape2::Polygon {
+                vertices: vertices.iter().map(|v| Vector2::new(v[0], v[1])).collect(),
+            },
+            BodySpec::Disc { diameter, centre } => Shape2::Disc {
+                centre: Vector2::new(centre[0], centre[1]),
+                radius: 0.5 * diameter,
+            },
+            BodySpec::Dogbone { size } => Shape2::DogBone { size: *size },
+            BodySpec::NotchedBeam {
+                length,
+                depth,
+                notch_depth,
+                notch_width,
+            } => Shape2::NotchedBeam {
+                length: *length,
+                depth: *depth,
+                notch_depth: *notch_depth,
+                notch_width: *notch_width,
+            },
+        }
+    }
+}

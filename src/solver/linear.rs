@@ -1,0 +1,89 @@
+//! The linearised SPLM operator about the reference configuration, matrix-free:
+//! (K·u)_i = −f_i(u) with S_ij = n_ij·(u_j − u_i)/L0_ij, θ_i = Σ_m S_im and
+//! f_i = Σ_j ½((a_i + a_j)·S_ij + b_i·θ_i + b_j·θ_j)·n_ij (MODEL.md §3–4 linearised).
+//! Used for the fundamental period and for the patch test at round-off accuracy.
+
+use super::mechanics::Mechanics;
+use nalgebra::SVector;
+use rayon::prelude::*;
+
+/// Matrix-free linear stiffness of a model.
+pub struct LinearOperator<'a, const D: usize, const K: usize> {
+    pub mech: &'a Mechanics<D, K>,
+    pub x0: &'a [SVector<f64, D>],
+    theta: Vec<f64>,
+}
+
+impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
+    pub fn new(mech: &'a Mechanics<D, K>, x0: &'a [SVector<f64, D>]) -> Self {
+        LinearOperator {
+            mech,
+            x0,
+            theta: vec![0.0; x0.len()],
+        }
+    }
+
+    /// Linearised bond stretches of particle i for displacements u.
+    #[inline]
+    fn stretch(
+        &self,
+        u: &[SVector<f64, D>],
+        i: usize,
+        j: usize,
+        il: f64,
+    ) -> (f64, SVector<f64, D>) {
+        let n = (self.x0[j] - self.x0[i]) * il;
+        (n.dot(&(u[j] - u[i])) * il, n)
+    }
+
+    /// Internal forces f(u) of the linearised model; `theta` holds Σ_m S_im afterwards.
+    pub fn internal_forces(&mut self, u: &[SVector<f64, D>], f: &mut [SVector<f64, D>]) {
+        let mech = self.mech;
+        let this = &*self;
+        let theta: Vec<f64> = (0..u.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|i| {
+                mech.bonds(i)
+                    .map(|(_, j, il)| this.stretch(u, i, j, il).0)
+                    .sum()
+            })
+            .collect();
+        f.par_iter_mut()
+            .with_min_len(1024)
+            .enumerate()
+            .for_each(|(i, fi)| {
+                let mut acc = SVector::<f64, D>::zeros();
+                for (_, j, il) in mech.bonds(i) {
+                    let (s, n) = this.stretch(u, i, j, il);
+                    let fb = 0.5
+                        * ((mech.a[i] + mech.a[j]) * s
+                            + mech.b[i] * theta[i]
+                            + mech.b[j] * theta[j]);
+                    acc += n * fb;
+                }
+                *fi = acc;
+            });
+        self.theta = theta;
+    }
+
+    /// Force states F_s,ij = a_i S_ij + b_i θ_i of particle i (linearised), slot by slot,
+    /// after [`Self::internal_forces`].
+    pub fn force_states(
+        &self,
+        u: &[SVector<f64, D>],
+        i: usize,
+    ) -> Vec<(SVector<f64, D>, f64, f64)> {
+        self.mech
+            .bonds(i)
+            .map(|(_, j, il)| {
+                let (s, n) = self.stretch(u, i, j, il);
+                (
+                    n,
+                    1.0 / il,
+                    self.mech.a[i] * s + self.mech.b[i] * self.theta[i],
+                )
+            })
+            .collect()
+    }
+}

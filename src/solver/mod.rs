@@ -1,0 +1,277 @@
+//! Time integration of a discretised specimen: the step kernel, displacement loading,
+//! probes (reaction force, energies) and the stability guard (ARCHITECTURE.md, "Solver").
+
+pub mod kernel;
+pub mod linear;
+pub mod loading;
+pub mod mechanics;
+pub mod modal;
+pub mod time_step;
+
+use kernel::State;
+use loading::{ramp_fraction, Prescribed};
+use mechanics::Mechanics;
+use nalgebra::SVector;
+
+use crate::scene::Ramp;
+
+/// How the run integrates.
+#[derive(Clone, Copy, Debug)]
+pub struct Integration {
+    pub dt: f64,
+    /// Reading (A) of MODEL.md §4 when true.
+    pub lagged_forces: bool,
+    pub ramp: Ramp,
+    pub t_ramp: f64,
+}
+
+/// One sample of the probes.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct Record {
+    pub step: usize,
+    pub time_s: f64,
+    /// Prescribed displacement of the probe group (m).
+    pub displacement_m: f64,
+    /// Reaction of the probe group along its component (N).
+    pub force_n: f64,
+    pub kinetic_j: f64,
+    pub internal_j: f64,
+    pub external_work_j: f64,
+    pub damping_j: f64,
+}
+
+/// The probe: a group and the component along which its reaction is summed.
+#[derive(Clone, Debug)]
+pub struct Probe {
+    pub members: Vec<u32>,
+    pub component: usize,
+    /// Δmax of the group along the component (0 for a support).
+    pub amplitude: f64,
+}
+
+/// A run that went unstable.
+#[derive(Debug, thiserror::Error)]
+#[error("the run went unstable at step {step} (t = {time:.6e} s): {what} at particle {particle} (reference position {position}); reduce solver.safety or solver.dt, or check the material")]
+pub struct Unstable {
+    pub step: usize,
+    pub time: f64,
+    pub particle: usize,
+    pub position: String,
+    pub what: String,
+}
+
+/// A simulation in progress.
+pub struct Simulation<const D: usize, const K: usize> {
+    pub x0: Vec<SVector<f64, D>>,
+    pub mech: Mechanics<D, K>,
+    pub state: State<D>,
+    pub prescribed: Vec<Prescribed>,
+    pub integration: Integration,
+    pub step: usize,
+    external_work: f64,
+    /// Energy scale for the blow-up test (initial energy or work done so far).
+    energy_scale: f64,
+}
+
+impl<const D: usize, const K: usize> Simulation<D, K> {
+    pub fn new(
+        x0: Vec<SVector<f64, D>>,
+        mech: Mechanics<D, K>,
+        prescribed: Vec<Prescribed>,
+        integration: Integration,
+    ) -> Self {
+        let state = State::at_rest(&x0);
+        Simulation {
+            x0,
+            mech,
+            state,
+            prescribed,
+            integration,
+            step: 0,
+            external_work: 0.0,
+            energy_scale: 0.0,
+        }
+    }
+
+    pub fn time(&self) -> f64 {
+        self.step as f64 * self.integration.dt
+    }
+
+    fn prescribed_at(&self, p: &Prescribed, t: f64) -> f64 {
+        p.amplitude * ramp_fraction(self.integration.ramp, t, self.integration.t_ramp)
+    }
+
+    /// Start from a given displacement field and velocity (free-vibration tests).
+    pub fn set_initial(&mut self, u: &[SVector<f64, D>], v: &[SVector<f64, D>]) {
+        for i in 0..self.x0.len() {
+            self.state.x[i] = self.x0[i] + u[i];
+            self.state.v[i] = v[i];
+        }
+        let (k, u_int) = (self.kinetic_energy(), self.internal_energy_now());
+        self.energy_scale = k + u_int;
+    }
+
+    /// Advance one step. Returns the probe record when `record` is given.
+    pub fn advance(&mut self, record: Option<&Probe>) -> Option<Record> {
+        let dt = self.integration.dt;
+        let damp = self.mech.has_bond_dampers();
+        match (self.integration.lagged_forces, damp) {
+            (false, false) => kernel::step::<D, K, false, false>(&self.mech, &mut self.state, dt),
+            (false, true) => kernel::step::<D, K, false, true>(&self.mech, &mut self.state, dt),
+            (true, false) => kernel::step::<D, K, true, false>(&self.mech, &mut self.state, dt),
+            (true, true) => kernel::step::<D, K, true, true>(&self.mech, &mut self.state, dt),
+        }
+        let t = self.time();
+        let (t_prev, t_next) = (t - dt, t + dt);
+        // Supports and displacement loading; work of the reactions (central rule).
+        let mut work = 0.0;
+        let mut work_half = 0.0;
+        for p in &self.prescribed {
+            let (i, c) = (p.particle as usize, p.component as usize);
+            let u_next = self.prescribed_at(p, t_next);
+            self.state.x_next[i][c] = self.x0[i][c] + u_next;
+            self.state.v_next[i][c] = (self.state.x_next[i][c] - self.state.x[i][c]) / dt;
+            if p.amplitude != 0.0 {
+                let reaction = -self.state.force[i][c];
+                let u_prev = if self.step == 0 {
+                    0.0
+                } else {
+                    self.prescribed_at(p, t_prev)
+                };
+                let u_now = self.prescribed_at(p, t);
+                work += reaction * 0.5 * (u_next - u_prev);
+                work_half += reaction * 0.5 * (u_now - u_prev);
+            }
+        }
+        let rec = record.map(|probe| {
+            let kinetic = self.kinetic_energy_mid();
+            Record {
+                step: self.step,
+                time_s: t,
+                displacement_m: probe.amplitude
+                    * ramp_fraction(self.integration.ramp, t, self.integration.t_ramp),
+                force_n: -probe
+                    .members
+                    .iter()
+                    .map(|&i| self.state.force[i as usize][probe.component])
+                    .sum::<f64>(),
+                kinetic_j: kinetic,
+                internal_j: self.internal_energy_now(),
+                external_work_j: self.external_work + work_half,
+                damping_j: self.state.damping_work.iter().sum(),
+            }
+        });
+        self.external_work += work;
+        if self.integration.lagged_forces {
+            std::mem::swap(&mut self.state.force, &mut self.state.force_prev);
+        }
+        std::mem::swap(&mut self.state.x, &mut self.state.x_next);
+        std::mem::swap(&mut self.state.v, &mut self.state.v_next);
+        self.step += 1;
+        rec
+    }
+
+    /// Kinetic energy of the free components at step n, v^n = ½(v^{n−½} + v^{n+½})
+    /// (before the swap).
+    fn kinetic_energy_mid(&self) -> f64 {
+        let st = &self.state;
+        let total: f64 = (0..self.x0.len())
+            .map(|i| 0.5 * self.mech.mass[i] * ((st.v[i] + st.v_next[i]) * 0.5).norm_squared())
+            .sum();
+        let held: f64 = self
+            .prescribed
+            .iter()
+            .map(|p| {
+                let i = p.particle as usize;
+                let vc = 0.5 * (st.v[i][p.component as usize] + st.v_next[i][p.component as usize]);
+                0.5 * self.mech.mass[i] * vc * vc
+            })
+            .sum();
+        total - held
+    }
+
+    /// Kinetic energy of the free components from v^{n−½}.
+    pub fn kinetic_energy(&self) -> f64 {
+        let st = &self.state;
+        let total: f64 = (0..self.x0.len())
+            .map(|i| 0.5 * self.mech.mass[i] * st.v[i].norm_squared())
+            .sum();
+        let held: f64 = self
+            .prescribed
+            .iter()
+            .map(|p| {
+                let i = p.particle as usize;
+                let vc = st.v[i][p.component as usize];
+                0.5 * self.mech.mass[i] * vc * vc
+            })
+            .sum();
+        total - held
+    }
+
+    /// Elastic energy stored in the bonds at the current positions,
+    /// U = ¼·Σ_i Σ_j L0,ij·S_ij·F_s,ij (so that ∂U/∂L_ij = F_b,ij; see MODEL.md §7).
+    pub fn internal_energy_now(&self) -> f64 {
+        let x = &self.state.x;
+        let m = &self.mech;
+        (0..x.len())
+            .map(|i| {
+                let mut sum_s = 0.0;
+                let mut sum_s2_l = 0.0;
+                let mut sum_s_l = 0.0;
+                for (_, j, il) in m.bonds(i) {
+                    let s = ((x[j] - x[i]).norm()) * il - 1.0;
+                    sum_s += s;
+                    sum_s2_l += s * s / il;
+                    sum_s_l += s / il;
+                }
+                0.25 * (m.a[i] * sum_s2_l + m.b[i] * sum_s * sum_s_l)
+            })
+            .sum()
+    }
+
+    /// Total work of the supports and the loading so far (J).
+    pub fn external_work(&self) -> f64 {
+        self.external_work
+    }
+
+    /// Stop with the step and the particle if the state is not finite or the kinetic
+    /// energy has grown beyond 100× everything put into the specimen.
+    pub fn check_stability(&mut self, internal: Option<f64>) -> Result<(), Unstable> {
+        let v = &self.state.v;
+        let x = &self.state.x;
+        let bad = (0..v.len())
+            .find(|&i| !(v[i].iter().all(|c| c.is_finite()) && x[i].iter().all(|c| c.is_finite())));
+        let kinetic = self.kinetic_energy();
+        if let Some(u) = internal {
+            self.energy_scale = self.energy_scale.max(u);
+        }
+        self.energy_scale = self.energy_scale.max(self.external_work.abs());
+        let blown = kinetic > 100.0 * self.energy_scale + 1e-300 && self.energy_scale > 0.0;
+        if bad.is_none() && kinetic.is_finite() && !blown {
+            return Ok(());
+        }
+        let (particle, what) = match bad {
+            Some(i) => (
+                i,
+                "the position or velocity is not a finite number".to_string(),
+            ),
+            None => {
+                let i = (0..v.len())
+                    .max_by(|&a, &b| {
+                        v[a].norm()
+                            .partial_cmp(&v[b].norm())
+                            .unwrap_or(std::cmp::Ordering::Equal)
+                    })
+                    .unwrap_or(0);
+                (i, format!("kinetic energy {kinetic:.3e} J exceeds 100× the energy put in ({:.3e} J); the fastest particle", self.energy_scale))
+            }
+        };
+        Err(Unstable {
+            step: self.step,
+            time: self.time(),
+            particle,
+            position: format!("{:?}", self.x0[particle].as_slice()),
+            what,
+        })
+    }
+}
