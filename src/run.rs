@@ -86,8 +86,20 @@ pub fn estimated_memory(scene: &Scene) -> f64 {
     estimated_particles(scene) * bytes_per_particle(2, 6) as f64
 }
 
-/// Discretise and assemble a scene, compute T1 and the time step.
-pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
+/// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step).
+pub struct Model {
+    pub scene: Scene,
+    pub particles: Particles<2, 6>,
+    pub groups: Vec<groups::Group>,
+    pub prescribed: Vec<Prescribed>,
+    pub constrained: Vec<[bool; 2]>,
+    pub mech: Mechanics<2, 6>,
+    pub bulk: MicroModuli,
+    pub surface: SurfaceCorrection,
+}
+
+/// Discretise a scene and assemble its model: lattice, groups, supports, micro-moduli.
+pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
     let d = &scene.discretisation;
     let m = &scene.material;
     let need = estimated_memory(scene);
@@ -220,8 +232,34 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
         }
     }
     let rho = vec![m.rho; n];
-    let mut mech = Mechanics::new(&particles, a, b, &rho);
+    let mech = Mechanics::new(&particles, a, b, &rho);
+    Ok(Model {
+        scene: scene.clone(),
+        particles,
+        groups,
+        prescribed,
+        constrained,
+        mech,
+        bulk,
+        surface,
+    })
+}
 
+/// Discretise and assemble a scene, compute T1 and the time step.
+pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
+    let Model {
+        scene: _,
+        particles,
+        groups,
+        prescribed,
+        constrained,
+        mut mech,
+        bulk,
+        surface,
+    } = prepare_model(scene)?;
+    let d = &scene.discretisation;
+    let m = &scene.material;
+    let n = particles.len();
     let fundamental = modal::fundamental(&mech, &particles.x0, &constrained)?;
     let omega_i = material::particle_frequency(m.e, m.nu, m.rho, d.spacing);
     let omega_struct = 2.0 * std::f64::consts::PI / fundamental.period;
@@ -349,6 +387,7 @@ pub struct Summary {
     pub spacing_m: f64,
     pub rotation_deg: f64,
     pub offset_m: [f64; 2],
+    pub omega_max_rad_s: f64,
     pub omega_max_bound_rad_s: f64,
     /// No random choice is made by the elastic lattice; recorded for reproducibility.
     pub seed: Option<u64>,
@@ -372,9 +411,13 @@ impl Outcome {
     }
 }
 
-/// Particle stresses (3.18) at positions x.
-pub fn particle_stress(p: &Prepared, x: &[Vector2<f64>]) -> Vec<Matrix2<f64>> {
-    let mech = &p.mech;
+/// Particle stresses (3.18) at positions x: σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(e_ij ⊗ e_ij)
+/// with F_s,ij = a_i·S_ij + b_i·Σ_m S_im and e_ij the current bond direction.
+pub fn particle_stress(
+    mech: &Mechanics<2, 6>,
+    volume: &[f64],
+    x: &[Vector2<f64>],
+) -> Vec<Matrix2<f64>> {
     (0..x.len())
         .map(|i| {
             let mut theta = 0.0;
@@ -388,7 +431,7 @@ pub fn particle_stress(p: &Prepared, x: &[Vector2<f64>]) -> Vec<Matrix2<f64>> {
                 let s = len * il - 1.0;
                 acc.add(&(d / len), 1.0 / il, mech.a[i] * s + mech.b[i] * theta);
             }
-            acc.finish(p.particles.volume[i])
+            acc.finish(volume[i])
         })
         .collect()
 }
@@ -468,7 +511,7 @@ fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcom
     let x = sim.state.x.clone();
     let displacement: Vec<Vector2<f64>> =
         x.iter().zip(&p.particles.x0).map(|(a, b)| a - b).collect();
-    let stress = particle_stress(&p, &x);
+    let stress = particle_stress(&p.mech, &p.particles.volume, &x);
     let summary = summarise(
         &p,
         &records,
@@ -553,7 +596,8 @@ fn summarise(
         spacing_m: d.spacing,
         rotation_deg: d.rotation_deg,
         offset_m: d.offset,
-        omega_max_bound_rad_s: p.stable.omega_max,
+        omega_max_rad_s: p.stable.omega_max,
+        omega_max_bound_rad_s: p.stable.omega_max_bound,
         seed: None,
         sppm_version: env!("CARGO_PKG_VERSION").to_string(),
     }

@@ -87,3 +87,25 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
             .collect()
     }
 }
+
+/// The bond dampers as a linear operator on velocities: (C·v)_i = Σ_j c_ij·((v_i − v_j)·e_ij)·e_ij,
+/// c_ij = ½(C_in,i + C_in,j), e_ij the reference bond direction (3.55).
+pub fn apply_bond_dampers<const D: usize, const K: usize>(
+    mech: &Mechanics<D, K>,
+    x0: &[SVector<f64, D>],
+    v: &[SVector<f64, D>],
+    out: &mut [SVector<f64, D>],
+) {
+    out.par_iter_mut()
+        .with_min_len(1024)
+        .enumerate()
+        .for_each(|(i, o)| {
+            let mut acc = SVector::<f64, D>::zeros();
+            for (_, j, il) in mech.bonds(i) {
+                let e = (x0[j] - x0[i]) * il;
+                let c = 0.5 * (mech.c_in[i] + mech.c_in[j]);
+                acc += e * (c * (v[i] - v[j]).dot(&e));
+            }
+            *o = acc;
+        });
+}

@@ -49,7 +49,7 @@ fn mask<const D: usize>(u: &mut [SVector<f64, D>], constrained: &[[bool; D]]) {
 
 /// Rigid-body modes (translations, and in 2D the rotation) that leave every constrained
 /// component at rest, M-orthonormalised.
-fn mechanisms<const D: usize>(
+pub fn mechanisms<const D: usize>(
     x0: &[SVector<f64, D>],
     mass: &[f64],
     constrained: &[[bool; D]],
@@ -154,7 +154,7 @@ fn mechanisms<const D: usize>(
     modes
 }
 
-fn deflate<const D: usize>(u: &mut [SVector<f64, D>], modes: &[Field<D>], mass: &[f64]) {
+pub fn deflate<const D: usize>(u: &mut [SVector<f64, D>], modes: &[Field<D>], mass: &[f64]) {
     for g in modes {
         let c = mdot(mass, u, g);
         for (a, b) in u.iter_mut().zip(g) {
@@ -180,24 +180,6 @@ pub fn fundamental<const D: usize, const K: usize>(
     let mass = &mech.mass;
     let modes = mechanisms(x0, mass, constrained);
     let mut op = LinearOperator::new(mech, x0);
-    // Jacobi preconditioner: diagonal blocks of the a-part, Σ_j ½(a_i + a_j)/L · n n.
-    let diag: Field<D> = (0..n)
-        .map(|i| {
-            let mut dg = SVector::<f64, D>::zeros();
-            for (_, j, il) in mech.bonds(i) {
-                let e = (x0[j] - x0[i]) * il;
-                dg += e.component_mul(&e) * (0.5 * (mech.a[i] + mech.a[j]) * il);
-            }
-            dg.map(|v| if v > 0.0 { 1.0 / v } else { 0.0 })
-        })
-        .collect();
-    let apply = |op: &mut LinearOperator<D, K>, u: &[SVector<f64, D>], out: &mut Field<D>| {
-        op.internal_forces(u, out);
-        for o in out.iter_mut() {
-            *o = -*o;
-        }
-        mask(out, constrained);
-    };
     // Start: a smooth field (positions), masked and deflated.
     let mut x: Field<D> = x0
         .iter()
@@ -217,77 +199,28 @@ pub fn fundamental<const D: usize, const K: usize>(
     x.iter_mut().for_each(|v| *v /= norm);
 
     let mut z: Field<D> = vec![SVector::zeros(); n];
-    let mut kz: Field<D> = vec![SVector::zeros(); n];
     let mut lambda_prev = f64::INFINITY;
-    let mut r: Field<D> = vec![SVector::zeros(); n];
-    let mut p: Field<D> = vec![SVector::zeros(); n];
-    let mut ap: Field<D> = vec![SVector::zeros(); n];
+    let mut work = CgWork::new(n);
     for it in 1..=60 {
-        // rhs = M x
+        // solve K z = M x, warm-started from the last z
         let rhs: Field<D> = x.iter().zip(mass).map(|(v, m)| v * *m).collect();
-        // CG on K z = rhs, warm start from the last z scaled
-        apply(&mut op, &z, &mut kz);
-        for i in 0..n {
-            r[i] = rhs[i] - kz[i];
-        }
-        deflate_euclid(&mut r, &modes, mass);
-        let bnorm = dot(&rhs, &rhs).sqrt();
-        let mut zr: Field<D> = r
-            .iter()
-            .zip(&diag)
-            .map(|(a, d)| a.component_mul(d))
-            .collect();
-        p.clone_from(&zr);
-        let mut rz = dot(&r, &zr);
-        let max_cg = 20 * (n as f64).sqrt() as usize + 200;
-        let mut converged = false;
-        for _ in 0..max_cg {
-            if dot(&r, &r).sqrt() <= 1e-10 * bnorm {
-                converged = true;
-                break;
-            }
-            apply(&mut op, &p, &mut ap);
-            let pap = dot(&p, &ap);
-            if !(pap > 0.0) {
-                return Err(ModalError::Failed(
-                    "the stiffness is not positive definite on the free components: the supports leave a mechanism that is not a rigid motion".into(),
-                ));
-            }
-            let alpha = rz / pap;
-            for i in 0..n {
-                z[i] += p[i] * alpha;
-                r[i] -= ap[i] * alpha;
-            }
-            zr = r
-                .iter()
-                .zip(&diag)
-                .map(|(a, d)| a.component_mul(d))
-                .collect();
-            let rz_new = dot(&r, &zr);
-            let beta = rz_new / rz;
-            rz = rz_new;
-            for i in 0..n {
-                p[i] = zr[i] + p[i] * beta;
-            }
-        }
-        if !converged {
-            return Err(ModalError::Failed(format!(
-                "conjugate gradients did not converge in {max_cg} iterations"
-            )));
-        }
+        conjugate_gradient(
+            &mut op,
+            constrained,
+            &modes,
+            mass,
+            &rhs,
+            &mut z,
+            1e-8,
+            &mut work,
+        )?;
         deflate(&mut z, &modes, mass);
         let zn = mdot(mass, &z, &z).sqrt();
         // Rayleigh quotient λ = xᵀKx / xᵀMx with x = z/|z|_M; since Kz = Mx: λ = zᵀMx/zᵀMz.
         let lambda = mdot(mass, &z, &x) / (zn * zn);
         x = z.iter().map(|v| v / zn).collect();
         z.iter_mut().for_each(|v| *v /= zn);
-        if std::env::var("SPPM_DEBUG_MODAL").is_ok() {
-            eprintln!(
-                "it {it} lambda {lambda:.9e} T {:.6e}",
-                2.0 * std::f64::consts::PI / lambda.sqrt()
-            );
-        }
-        if (lambda - lambda_prev).abs() <= 1e-7 * lambda {
+        if (lambda - lambda_prev).abs() <= 1e-6 * lambda {
             return Ok(Fundamental {
                 eigenvalue: lambda,
                 period: 2.0 * std::f64::consts::PI / lambda.sqrt(),
@@ -312,4 +245,161 @@ fn deflate_euclid<const D: usize>(r: &mut [SVector<f64, D>], modes: &[Field<D>],
             *a -= b * c;
         }
     }
+}
+
+/// Scratch vectors of [`conjugate_gradient`].
+pub struct CgWork<const D: usize> {
+    r: Field<D>,
+    p: Field<D>,
+    ap: Field<D>,
+    zr: Field<D>,
+    diag: Option<Field<D>>,
+}
+
+impl<const D: usize> CgWork<D> {
+    pub fn new(n: usize) -> Self {
+        let z = vec![SVector::zeros(); n];
+        CgWork {
+            r: z.clone(),
+            p: z.clone(),
+            ap: z.clone(),
+            zr: z,
+            diag: None,
+        }
+    }
+}
+
+/// Solve K·z = rhs on the free components (constrained ones held at zero) by conjugate
+/// gradients with a Jacobi preconditioner, from the initial guess in `z`. Mechanisms
+/// (rigid motions the constraints leave free) are projected out of the residual.
+/// Returns the number of iterations.
+#[allow(clippy::too_many_arguments)]
+pub fn conjugate_gradient<const D: usize, const K: usize>(
+    op: &mut LinearOperator<D, K>,
+    constrained: &[[bool; D]],
+    modes: &[Field<D>],
+    mass: &[f64],
+    rhs: &[SVector<f64, D>],
+    z: &mut Field<D>,
+    tol: f64,
+    w: &mut CgWork<D>,
+) -> Result<usize, ModalError> {
+    let n = rhs.len();
+    let mech = op.mech;
+    let x0 = op.x0;
+    let diag = w.diag.get_or_insert_with(|| {
+        // diagonal blocks of the a-part, Σ_j ½(a_i + a_j)/L · n n
+        (0..n)
+            .map(|i| {
+                let mut dg = SVector::<f64, D>::zeros();
+                for (_, j, il) in mech.bonds(i) {
+                    let e = (x0[j] - x0[i]) * il;
+                    dg += e.component_mul(&e) * (0.5 * (mech.a[i] + mech.a[j]) * il);
+                }
+                dg.map(|v| if v > 0.0 { 1.0 / v } else { 0.0 })
+            })
+            .collect()
+    });
+    let apply = |op: &mut LinearOperator<D, K>, u: &[SVector<f64, D>], out: &mut Field<D>| {
+        op.internal_forces(u, out);
+        for o in out.iter_mut() {
+            *o = -*o;
+        }
+        mask(out, constrained);
+    };
+    mask(z, constrained);
+    apply(op, z, &mut w.ap);
+    for i in 0..n {
+        w.r[i] = rhs[i] - w.ap[i];
+    }
+    mask(&mut w.r, constrained);
+    deflate_euclid(&mut w.r, modes, mass);
+    let bnorm = dot(rhs, rhs).sqrt().max(1e-300);
+    for i in 0..n {
+        w.zr[i] = w.r[i].component_mul(&diag[i]);
+    }
+    w.p.clone_from(&w.zr);
+    let mut rz = dot(&w.r, &w.zr);
+    // CG needs O(√cond) iterations and cond grows with (extent/L0)²: allow 200 per spacing
+    let (mut lo, mut hi) = (x0[0], x0[0]);
+    for x in x0 {
+        lo = lo.inf(x);
+        hi = hi.sup(x);
+    }
+    let l0_min = (0..n)
+        .flat_map(|i| mech.bonds(i).map(|(_, _, il)| 1.0 / il))
+        .fold(f64::INFINITY, f64::min);
+    let max_cg = (200.0 * (hi - lo).norm() / l0_min) as usize + 500;
+    for it in 0..max_cg {
+        if dot(&w.r, &w.r).sqrt() <= tol * bnorm {
+            return Ok(it);
+        }
+        apply(op, &w.p, &mut w.ap);
+        let pap = dot(&w.p, &w.ap);
+        if !(pap > 0.0) {
+            return Err(ModalError::Failed(
+                "the stiffness is not positive definite on the free components: the supports leave a mechanism that is not a rigid motion".into(),
+            ));
+        }
+        let alpha = rz / pap;
+        for i in 0..n {
+            z[i] += w.p[i] * alpha;
+            w.r[i] -= w.ap[i] * alpha;
+        }
+        for i in 0..n {
+            w.zr[i] = w.r[i].component_mul(&diag[i]);
+        }
+        let rz_new = dot(&w.r, &w.zr);
+        let beta = rz_new / rz;
+        rz = rz_new;
+        for i in 0..n {
+            w.p[i] = w.zr[i] + w.p[i] * beta;
+        }
+    }
+    Err(ModalError::Failed(format!(
+        "conjugate gradients did not converge in {max_cg} iterations"
+    )))
+}
+
+/// Static linear-elastic response to prescribed displacements (small strain): the
+/// displacement field u with u = ū on the constrained components and K·u = 0 on the free
+/// ones. Used by the verification tests (stiffness, E and ν, rotation objectivity).
+pub fn static_response<const D: usize, const K: usize>(
+    mech: &Mechanics<D, K>,
+    x0: &[SVector<f64, D>],
+    constrained: &[[bool; D]],
+    prescribed: &[SVector<f64, D>],
+) -> Result<Field<D>, ModalError> {
+    let n = x0.len();
+    let modes = mechanisms(x0, &mech.mass, constrained);
+    let mut op = LinearOperator::new(mech, x0);
+    // rhs = −K ū on the free components
+    let mut ku: Field<D> = vec![SVector::zeros(); n];
+    op.internal_forces(prescribed, &mut ku);
+    let rhs: Field<D> = ku; // f(ū) = −K ū
+    let mut rhs = rhs;
+    mask(&mut rhs, constrained);
+    let mut z: Field<D> = vec![SVector::zeros(); n];
+    let mut w = CgWork::new(n);
+    conjugate_gradient(
+        &mut op,
+        constrained,
+        &modes,
+        &mech.mass,
+        &rhs,
+        &mut z,
+        1e-12,
+        &mut w,
+    )?;
+    Ok((0..n)
+        .map(|i| {
+            let mut u = z[i];
+            for d in 0..D {
+                if constrained[i][d] {
+                    u[d] = prescribed[i][d];
+                }
+            }
+            u
+        })
+        .collect())
 }

@@ -1,0 +1,126 @@
+//! Shared helpers of the verification tests.
+#![allow(dead_code)]
+
+use nalgebra::{Matrix3, Vector2, Vector3};
+use sppm::run::Model as Prepared;
+use sppm::solver::linear::LinearOperator;
+use sppm::solver::modal::static_response;
+use sppm::Scene;
+
+/// A rectangular plate in uniaxial tension: bottom rows held in y, one particle at the
+/// bottom centre held in x, top rows pulled `strain × height` in y.
+pub fn plate_toml(
+    width: f64,
+    height: f64,
+    spacing: f64,
+    rotation: f64,
+    plane: &str,
+    correction: bool,
+    nu: f64,
+) -> String {
+    format!(
+        r#"
+name = "plate"
+[body]
+shape = "rectangle"
+width = {width}
+height = {height}
+[discretisation]
+spacing = {spacing}
+rotation_deg = {rotation}
+surface_correction = {correction}
+[material]
+E = 30.0e9
+nu = {nu}
+rho = 2400.0
+thickness = 0.05
+plane = "{plane}"
+[[groups]]
+name = "bottom"
+select = {{ by = "edge", edge = "bottom", rows = 2 }}
+fix = ["y"]
+[[groups]]
+name = "anchor"
+select = {{ by = "box", min = [{ax0}, -{h}], max = [{ax1}, {h}] }}
+fix = ["x"]
+[[groups]]
+name = "top"
+select = {{ by = "edge", edge = "top", rows = 2 }}
+load = {{ component = "y", displacement = {disp} }}
+[loading]
+end_periods = 4.0
+[damping]
+internal = 0.2
+external = 1.0
+"#,
+        ax0 = 0.5 * width - 0.6 * spacing,
+        ax1 = 0.5 * width + 0.6 * spacing,
+        h = 0.6 * spacing,
+        disp = 1e-4 * height,
+    )
+}
+
+pub fn scene(toml: &str) -> Scene {
+    Scene::from_toml_str(toml, &[]).expect("test scene is valid")
+}
+
+/// Prescribed displacement field at full load.
+pub fn full_load(p: &Prepared) -> Vec<Vector2<f64>> {
+    let mut u = vec![Vector2::zeros(); p.particles.len()];
+    for pr in &p.prescribed {
+        u[pr.particle as usize][pr.component as usize] = pr.amplitude;
+    }
+    u
+}
+
+/// Static small-strain response to the full prescribed displacements.
+pub fn static_solution(p: &Prepared) -> Vec<Vector2<f64>> {
+    static_response(&p.mech, &p.particles.x0, &p.constrained, &full_load(p)).expect("static solve")
+}
+
+/// Reaction along y of a group for displacements u (linearised forces).
+pub fn reaction_y(p: &Prepared, u: &[Vector2<f64>], group: &str) -> f64 {
+    let mut op = LinearOperator::new(&p.mech, &p.particles.x0);
+    let mut f = vec![Vector2::zeros(); u.len()];
+    op.internal_forces(u, &mut f);
+    let g = p.groups.iter().find(|g| g.name == group).unwrap();
+    -g.members.iter().map(|&i| f[i as usize].y).sum::<f64>()
+}
+
+/// Least-squares affine fit u ≈ A·x + c over the particles selected by `keep`; returns A.
+pub fn fit_gradient(
+    x0: &[Vector2<f64>],
+    u: &[Vector2<f64>],
+    keep: impl Fn(&Vector2<f64>) -> bool,
+) -> nalgebra::Matrix2<f64> {
+    let mut ata = Matrix3::zeros();
+    let mut atb = [Vector3::zeros(), Vector3::zeros()];
+    for (x, ui) in x0.iter().zip(u) {
+        if !keep(x) {
+            continue;
+        }
+        let row = Vector3::new(x.x, x.y, 1.0);
+        ata += row * row.transpose();
+        atb[0] += row * ui.x;
+        atb[1] += row * ui.y;
+    }
+    let inv = ata.try_inverse().unwrap();
+    let gx = inv * atb[0];
+    let gy = inv * atb[1];
+    nalgebra::Matrix2::new(gx[0], gx[1], gy[0], gy[1])
+}
+
+/// E and ν of a plate measured as an engineer would: σ = F/(W·t), strains fitted over the
+/// middle half of the plate (away from edges and grips).
+pub fn measure_e_nu(p: &Prepared, width: f64, height: f64, thickness: f64) -> (f64, f64) {
+    let u = static_solution(p);
+    let f = reaction_y(p, &u, "top");
+    let cx = 0.5 * width;
+    let cy = 0.5 * height;
+    let g = fit_gradient(&p.particles.x0, &u, |x| {
+        (x.x - cx).abs() <= 0.25 * width && (x.y - cy).abs() <= 0.25 * height
+    });
+    let (exx, eyy) = (g[(0, 0)], g[(1, 1)]);
+    let sigma = f / (width * thickness);
+    (sigma / eyy, -exx / eyy)
+}
