@@ -83,27 +83,16 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
             centre,
             depth,
         } => {
+            // a particle is under the strip when it lies within `depth` of the body's own
+            // surface at its tangent position (so a curved surface, a disc's, is followed)
             let (n, t) = edge_frame(*edge);
             let half = 0.5 * width + eps;
-            let in_band = |x: &Vector2<f64>| (x.dot(&t) - centre).abs() <= half;
-            let hmax =
-                p.x0.iter()
-                    .filter(|x| in_band(x))
-                    .map(|x| x.dot(&n))
-                    .fold(f64::NEG_INFINITY, f64::max);
-            let depth = depth.unwrap_or_else(|| {
-                let hc = boundary_height(shape, n, t, *centre);
-                let he = [centre - 0.5 * width, centre + 0.5 * width]
-                    .iter()
-                    .filter_map(|s| boundary_height(shape, n, t, *s))
-                    .fold(f64::INFINITY, f64::min);
-                let sag = match hc {
-                    Some(hc) if he.is_finite() => (hc - he).max(0.0),
-                    _ => 0.0,
-                };
-                sag + 0.75 * pitch
-            });
-            pick(&|x| in_band(x) && x.dot(&n) >= hmax - depth)
+            let depth = depth.unwrap_or(2.0 * pitch);
+            pick(&|x| {
+                let s = x.dot(&t);
+                (s - centre).abs() <= half
+                    && boundary_height(shape, n, t, s).is_some_and(|h| x.dot(&n) >= h - depth)
+            })
         }
     }
 }

@@ -155,7 +155,7 @@ mod tests {
         let s = Shape2::Rectangle {
             origin: Vector2::zeros(),
             width: 0.1,
-            height: 0.1 * 3f64.sqrt() / 2.0 * 4.0,
+            height: 0.01 * 3f64.sqrt() / 2.0 * 4.0,
         };
         let p = lattice(0.0).fill(&s);
         p.check_topology().unwrap();

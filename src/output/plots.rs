@@ -127,11 +127,15 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
     }
     let l0 = o.summary.spacing_m * 1e3;
     let (x0, x1, y0, y1) = (x0 - l0, x1 + l0, y0 - l0, y1 + l0);
-    let (vmin, vmax) = values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
+    // colour range: 1st to 99th percentile, so that a few boundary particles (whose
+    // one-sided bond sums give low particle stresses) do not wash out the interior
+    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    sorted.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let quantile = |f: f64| {
+        let k = ((sorted.len().max(1) - 1) as f64 * f).round() as usize;
+        sorted.get(k).copied().unwrap_or(0.0)
+    };
+    let (vmin, vmax) = (quantile(0.01), quantile(0.99));
     let span = if vmax > vmin { vmax - vmin } else { 1.0 };
     // plot area sized to the body's aspect ratio
     let plot_w = 700.0;
@@ -175,7 +179,8 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
         .map_err(err)?;
     // colour bar
     let mut cb = ChartBuilder::on(&bar)
-        .margin_top(40)
+        .caption("1st–99th pct", ("sans-serif", 13))
+        .margin_top(20)
         .margin_bottom(60)
         .margin_right(10)
         .y_label_area_size(70)
@@ -185,6 +190,8 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
         .disable_mesh()
         .disable_x_axis()
         .y_labels(8)
+        .y_label_style(("sans-serif", 14))
+        .y_label_formatter(&|v| format!("{v:.3}"))
         .draw()
         .map_err(err)?;
     let steps = 100;

@@ -174,7 +174,8 @@ pub enum Selection {
     /// The `rows` particle rows nearest an edge (row pitch √3/2·L0).
     Edge { edge: Edge, rows: u32 },
     /// The particles under a loading strip (platen) of `width` centred at `centre` along the
-    /// edge, down to `depth` from the body's extreme (default: the strip's sag plus one row).
+    /// edge: those within `depth` of the body's surface at their position (default: two
+    /// row pitches, √3·L0), so that a curved surface is followed.
     Strip {
         edge: Edge,
         width: f64,

@@ -193,7 +193,7 @@ pub fn fundamental<const D: usize, const K: usize>(
     mask(&mut x, constrained);
     deflate(&mut x, &modes, mass);
     let norm = mdot(mass, &x, &x).sqrt();
-    if !(norm > 0.0) {
+    if norm.is_nan() || norm <= 0.0 {
         return Err(ModalError::Failed("every particle is constrained".into()));
     }
     x.iter_mut().for_each(|v| *v /= norm);
@@ -300,24 +300,51 @@ pub fn conjugate_gradient<const D: usize, const K: usize>(
             })
             .collect()
     });
+    // Each mechanism g (M-normalised) gets a penalty σ_g·(Mg)(Mg)ᵀ so that the operator is
+    // positive definite: since Kg = 0 and the right-hand side is orthogonal to g, the
+    // solution of the penalised system is the M-orthogonal solution of K·z = rhs, and CG no
+    // longer lets round-off grow along g. σ_g puts g's eigenvalue at a typical K/M ratio.
+    let typical = (0..n)
+        .map(|i| {
+            diag[i]
+                .iter()
+                .filter(|v| **v > 0.0)
+                .map(|v| 1.0 / v)
+                .sum::<f64>()
+                / mass[i]
+        })
+        .sum::<f64>()
+        / n as f64;
+    let penalties: Vec<(Field<D>, f64)> = modes
+        .iter()
+        .map(|g| {
+            let mg: Field<D> = g.iter().zip(mass).map(|(v, m)| v * *m).collect();
+            let sigma = typical / dot(&mg, &mg);
+            (mg, sigma)
+        })
+        .collect();
     let apply = |op: &mut LinearOperator<D, K>, u: &[SVector<f64, D>], out: &mut Field<D>| {
         op.internal_forces(u, out);
         for o in out.iter_mut() {
             *o = -*o;
         }
+        for (mg, sigma) in &penalties {
+            let c = sigma * dot(mg, u);
+            for (o, v) in out.iter_mut().zip(mg) {
+                *o += v * c;
+            }
+        }
         mask(out, constrained);
     };
     mask(z, constrained);
     apply(op, z, &mut w.ap);
-    for i in 0..n {
-        w.r[i] = rhs[i] - w.ap[i];
+    for ((r, b), ap) in w.r.iter_mut().zip(rhs).zip(&w.ap) {
+        *r = b - ap;
     }
     mask(&mut w.r, constrained);
     deflate_euclid(&mut w.r, modes, mass);
     let bnorm = dot(rhs, rhs).sqrt().max(1e-300);
-    for i in 0..n {
-        w.zr[i] = w.r[i].component_mul(&diag[i]);
-    }
+    precondition(&w.r, diag, &mut w.zr);
     w.p.clone_from(&w.zr);
     let mut rz = dot(&w.r, &w.zr);
     // CG needs O(√cond) iterations and cond grows with (extent/L0)²: allow 200 per spacing
@@ -336,24 +363,24 @@ pub fn conjugate_gradient<const D: usize, const K: usize>(
         }
         apply(op, &w.p, &mut w.ap);
         let pap = dot(&w.p, &w.ap);
-        if !(pap > 0.0) {
+        if pap.is_nan() || pap <= 0.0 {
             return Err(ModalError::Failed(
                 "the stiffness is not positive definite on the free components: the supports leave a mechanism that is not a rigid motion".into(),
             ));
         }
         let alpha = rz / pap;
-        for i in 0..n {
-            z[i] += w.p[i] * alpha;
-            w.r[i] -= w.ap[i] * alpha;
+        for (zi, p) in z.iter_mut().zip(&w.p) {
+            *zi += p * alpha;
         }
-        for i in 0..n {
-            w.zr[i] = w.r[i].component_mul(&diag[i]);
+        for (r, ap) in w.r.iter_mut().zip(&w.ap) {
+            *r -= ap * alpha;
         }
+        precondition(&w.r, diag, &mut w.zr);
         let rz_new = dot(&w.r, &w.zr);
         let beta = rz_new / rz;
         rz = rz_new;
-        for i in 0..n {
-            w.p[i] = w.zr[i] + w.p[i] * beta;
+        for (p, zr) in w.p.iter_mut().zip(&w.zr) {
+            *p = zr + *p * beta;
         }
     }
     Err(ModalError::Failed(format!(
@@ -402,4 +429,15 @@ pub fn static_response<const D: usize, const K: usize>(
             u
         })
         .collect())
+}
+
+/// Jacobi preconditioning: zr = diag ∘ r.
+fn precondition<const D: usize>(
+    r: &[SVector<f64, D>],
+    diag: &[SVector<f64, D>],
+    zr: &mut [SVector<f64, D>],
+) {
+    for ((z, r), d) in zr.iter_mut().zip(r).zip(diag) {
+        *z = r.component_mul(d);
+    }
 }

@@ -1,0 +1,189 @@
+//! The command line as a user meets it: `run` writes every output, `check` reports, `bench`
+//! prints one JSON line, bad input and unstable runs stop with a message and a non-zero
+//! status.
+
+use std::path::Path;
+use std::process::Command;
+
+fn sppm(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_sppm"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("sppm runs")
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("sppm-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+const FAST: [&str; 4] = [
+    "--set",
+    "discretisation.spacing=0.005",
+    "--set",
+    "loading.end_periods=3",
+];
+
+#[test]
+fn run_writes_every_output() {
+    let out = tmp("run");
+    let o = sppm(
+        &[
+            &[
+                "run",
+                "lattices/elastic_plate.toml",
+                "--quiet",
+                "--out",
+                out.to_str().unwrap(),
+            ][..],
+            &FAST[..],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in [
+        "summary.json",
+        "force_displacement.csv",
+        "force_displacement.svg",
+        "particle_map.svg",
+        "particles.vtk",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "scene",
+        "particles",
+        "bonds",
+        "steps",
+        "dt_s",
+        "wall_time_s",
+        "peak_force_N",
+        "displacement_at_peak_m",
+        "final_displacement_m",
+        "dissipated_energy_J",
+        "max_kinetic_to_internal_energy",
+        "status",
+    ] {
+        assert!(summary.get(key).is_some(), "summary.json lacks {key}");
+    }
+    assert_eq!(summary["status"], "completed");
+    assert_eq!(summary["scene"], "elastic_plate");
+    // the plate's elastic answer: F = E·ε·W·t with ε ≈ Δ/(grip distance) ≈ 1.02e-4
+    let f = summary["peak_force_N"].as_f64().unwrap();
+    assert!(
+        (f / (30e9 * 1.02e-4 * 0.1 * 0.05) - 1.0).abs() < 0.03,
+        "{f}"
+    );
+    let csv = std::fs::read_to_string(out.join("force_displacement.csv")).unwrap();
+    assert!(csv.starts_with(
+        "step,time_s,displacement_m,force_N,kinetic_J,internal_J,external_work_J,damping_J"
+    ));
+    assert!(csv.lines().count() > 100);
+    let svg = std::fs::read_to_string(out.join("force_displacement.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("reaction force (kN)") && svg.contains("(mm)"));
+    let map = std::fs::read_to_string(out.join("particle_map.svg")).unwrap();
+    assert!(map.matches("<circle").count() >= summary["particles"].as_u64().unwrap() as usize);
+    let vtk = std::fs::read(out.join("particles.vtk")).unwrap();
+    assert!(vtk.starts_with(b"# vtk DataFile Version 3.0"));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn check_reports_size_step_and_estimates() {
+    let o = sppm(&["check", "lattices/elastic_plate.toml"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    for word in [
+        "particles",
+        "bonds",
+        "time step dt",
+        "steps",
+        "memory (est.)",
+        "run time (est.)",
+        "fundamental T1",
+    ] {
+        assert!(text.contains(word), "check output lacks {word}:\n{text}");
+    }
+}
+
+#[test]
+fn bench_prints_one_json_line() {
+    let o = sppm(&[
+        "bench",
+        "--particles",
+        "3000",
+        "--steps",
+        "20",
+        "--threads",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(text.lines().count(), 1);
+    let v: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
+    for key in [
+        "particles",
+        "steps",
+        "threads",
+        "model",
+        "particle_steps_per_s",
+    ] {
+        assert!(v.get(key).is_some(), "{key}");
+    }
+    assert!(v["particle_steps_per_s"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn bad_input_stops_with_the_key_and_a_non_zero_status() {
+    let o = sppm(&[
+        "run",
+        "lattices/elastic_plate.toml",
+        "--quiet",
+        "--set",
+        "material.nu=0.7",
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("material.nu = 0.7") && err.contains("-1 < nu < 0.5"),
+        "{err}"
+    );
+    assert!(err.lines().count() == 1, "one clear message: {err}");
+    let o = sppm(&["run", "lattices/no_such_scene.toml"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read lattices/no_such_scene.toml"));
+    assert!(!Path::new("output/no_such_scene").exists());
+}
+
+#[test]
+fn an_unstable_run_names_step_and_particle() {
+    let out = tmp("unstable");
+    let o = sppm(
+        &[
+            &[
+                "run",
+                "lattices/elastic_plate.toml",
+                "--quiet",
+                "--out",
+                out.to_str().unwrap(),
+                "--set",
+                "solver.force_lag=previous",
+            ][..],
+            &FAST[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(o.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("unstable at step") && err.contains("at particle"),
+        "{err}"
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(summary.contains("\"status\": \"unstable\""));
+    let _ = std::fs::remove_dir_all(&out);
+}
