@@ -2,6 +2,7 @@
 //! probes (reaction force, energies) and the stability guard (ARCHITECTURE.md, "Solver").
 
 pub mod kernel;
+pub mod lanczos;
 pub mod linear;
 pub mod loading;
 pub mod mechanics;

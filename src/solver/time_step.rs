@@ -15,9 +15,10 @@
 //! ([`Mechanics::max_eigenvalue_bound`]): the Lanczos value must lie below it. The estimate
 //! is checked against the measured instability threshold in tests/stability.rs.
 
+use super::lanczos::{Extreme, Lanczos};
 use super::linear::{apply_bond_dampers, LinearOperator};
 use super::mechanics::Mechanics;
-use nalgebra::{DMatrix, SVector};
+use nalgebra::SVector;
 
 /// Relative allowance added to the Lanczos eigenvalues.
 pub const LANCZOS_MARGIN: f64 = 0.04;
@@ -37,65 +38,21 @@ pub struct StableStep {
     pub dt_stable: f64,
 }
 
-/// Largest eigenvalue of the symmetric operator M^{-1/2}·A·M^{-1/2} by Lanczos.
-fn lanczos_max<const D: usize>(
+/// Largest eigenvalue of M^{-1/2}·A·M^{-1/2}, all components free.
+fn largest<const D: usize>(
     mass: &[f64],
-    steps: usize,
-    mut apply: impl FnMut(&[SVector<f64, D>], &mut [SVector<f64, D>]),
+    apply: impl FnMut(&[SVector<f64, D>], &mut [SVector<f64, D>]),
 ) -> f64 {
-    let n = mass.len();
-    let inv_sqrt_m: Vec<f64> = mass.iter().map(|m| 1.0 / m.sqrt()).collect();
-    // deterministic pseudo-random start (xorshift), so the limit is reproducible
-    let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
-    let mut rnd = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let mut q: Vec<SVector<f64, D>> = (0..n).map(|_| SVector::from_fn(|_, _| rnd())).collect();
-    let norm = q.iter().map(|v| v.norm_squared()).sum::<f64>().sqrt();
-    q.iter_mut().for_each(|v| *v /= norm);
-    let mut q_prev = vec![SVector::<f64, D>::zeros(); n];
-    let mut scaled = vec![SVector::<f64, D>::zeros(); n];
-    let mut w = vec![SVector::<f64, D>::zeros(); n];
-    let (mut alpha, mut beta) = (Vec::new(), Vec::new());
-    let mut beta_prev = 0.0;
-    for _ in 0..steps.min(D * n) {
-        for i in 0..n {
-            scaled[i] = q[i] * inv_sqrt_m[i];
-        }
-        apply(&scaled, &mut w);
-        for i in 0..n {
-            w[i] = w[i] * inv_sqrt_m[i] - q_prev[i] * beta_prev;
-        }
-        let a: f64 = w.iter().zip(&q).map(|(x, y)| x.dot(y)).sum();
-        for i in 0..n {
-            w[i] -= q[i] * a;
-        }
-        let b = w.iter().map(|v| v.norm_squared()).sum::<f64>().sqrt();
-        alpha.push(a);
-        if b <= 1e-14 * a.abs().max(1e-300) {
-            break;
-        }
-        beta.push(b);
-        for i in 0..n {
-            q_prev[i] = q[i];
-            q[i] = w[i] / b;
-        }
-        beta_prev = b;
+    Lanczos {
+        mass,
+        constrained: None,
+        deflate: &[],
+        which: Extreme::Largest,
+        tolerance: 0.0,
+        max_steps: LANCZOS_STEPS,
     }
-    let m = alpha.len();
-    let t = DMatrix::from_fn(m, m, |r, c| {
-        if r == c {
-            alpha[r]
-        } else if r + 1 == c || c + 1 == r {
-            beta[r.min(c)]
-        } else {
-            0.0
-        }
-    });
-    t.symmetric_eigenvalues().max()
+    .run(apply)
+    .eigenvalue
 }
 
 pub fn stable_step<const D: usize, const K: usize>(
@@ -103,16 +60,15 @@ pub fn stable_step<const D: usize, const K: usize>(
     x0: &[SVector<f64, D>],
 ) -> StableStep {
     let mut op = LinearOperator::new(mech, x0);
-    let lambda_k = lanczos_max::<D>(&mech.mass, LANCZOS_STEPS, |u, out| {
+    let lambda_k = largest::<D>(&mech.mass, |u, out| {
         op.internal_forces(u, out);
         out.iter_mut().for_each(|v| *v = -*v);
     }) * (1.0 + LANCZOS_MARGIN);
     let bound = mech.max_eigenvalue_bound(x0);
     let omega_max = lambda_k.min(bound).sqrt();
     let rate = if mech.has_bond_dampers() {
-        let r = lanczos_max::<D>(&mech.mass, LANCZOS_STEPS, |v, out| {
-            apply_bond_dampers(mech, x0, v, out)
-        }) * (1.0 + LANCZOS_MARGIN);
+        let r = largest::<D>(&mech.mass, |v, out| apply_bond_dampers(mech, x0, v, out))
+            * (1.0 + LANCZOS_MARGIN);
         r.min(mech.max_bond_damping_rate())
     } else {
         0.0
