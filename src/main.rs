@@ -121,9 +121,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 t_ramp: sc.loading.ramp_fraction * p.t_end,
             };
             let mut sim = sppm::solver::Simulation::new(
-                p.particles.x0.clone(),
-                p.mech.clone(),
-                p.prescribed.clone(),
+                p.model.particles.x0.clone(),
+                p.model.mech.clone(),
+                p.model.prescribed.clone(),
                 probe,
             );
             let calib = 20.min(p.steps.max(1));
@@ -133,11 +133,12 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             }
             let per_step = t.elapsed().as_secs_f64() / calib as f64;
             println!("scene            {}", sc.name());
-            println!("particles        {}", p.particles.len());
-            println!("bonds            {}", p.particles.bonds());
+            println!("particles        {}", p.model.particles.len());
+            println!("bonds            {}", p.model.particles.bonds());
             println!(
                 "groups           {}",
-                p.groups
+                p.model
+                    .groups
                     .iter()
                     .map(|g| format!("{} ({})", g.name, g.members.len()))
                     .collect::<Vec<_>>()
@@ -156,7 +157,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             );
             println!(
                 "surface corr.    {} of {} boundary particles",
-                p.surface.corrected, p.surface.boundary_particles
+                p.model.surface.corrected, p.model.surface.boundary_particles
             );
             Ok(ExitCode::SUCCESS)
         }

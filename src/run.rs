@@ -49,16 +49,9 @@ pub struct SurfaceCorrection {
     pub max_residual: f64,
 }
 
-/// A discretised, assembled specimen ready to run.
+/// A discretised, assembled specimen ready to run: the model plus its dynamics.
 pub struct Prepared {
-    pub scene: Scene,
-    pub particles: Particles<2, 6>,
-    pub groups: Vec<groups::Group>,
-    pub prescribed: Vec<Prescribed>,
-    pub constrained: Vec<[bool; 2]>,
-    pub mech: Mechanics<2, 6>,
-    pub bulk: MicroModuli,
-    pub surface: SurfaceCorrection,
+    pub model: Model,
     pub fundamental: modal::Fundamental,
     pub stable: StableStep,
     pub dt: f64,
@@ -247,27 +240,19 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
 
 /// Discretise and assemble a scene, compute T1 and the time step.
 pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
-    let Model {
-        scene: _,
-        particles,
-        groups,
-        prescribed,
-        constrained,
-        mut mech,
-        bulk,
-        surface,
-    } = prepare_model(scene)?;
+    let mut model = prepare_model(scene)?;
     let d = &scene.discretisation;
     let m = &scene.material;
-    let n = particles.len();
-    let fundamental = modal::fundamental(&mech, &particles.x0, &constrained)?;
+    let n = model.particles.len();
+    let fundamental = modal::fundamental(&model.mech, &model.particles.x0, &model.constrained)?;
     let omega_i = material::particle_frequency(m.e, m.nu, m.rho, d.spacing);
     let omega_struct = 2.0 * std::f64::consts::PI / fundamental.period;
+    let mech = &mut model.mech;
     for i in 0..n {
         mech.c_in[i] = 2.0 * mech.mass[i] * scene.damping.internal * omega_i;
         mech.c_ex[i] = 2.0 * mech.mass[i] * scene.damping.external * omega_struct;
     }
-    let stable = stable_step(&mech, &particles.x0);
+    let stable = stable_step(&model.mech, &model.particles.x0);
     let dt = match scene.solver.dt {
         Some(dt) if dt > stable.dt_stable => {
             return Err(RunError::Scene(crate::scene::SceneError::Invalid {
@@ -303,7 +288,8 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
     });
     let probe = probe_name.map(|name| {
         let spec = scene.groups.iter().find(|g| g.name == name).unwrap();
-        let members = groups
+        let members = model
+            .groups
             .iter()
             .find(|g| g.name == name)
             .unwrap()
@@ -324,14 +310,7 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
     });
 
     Ok(Prepared {
-        scene: scene.clone(),
-        particles,
-        groups,
-        prescribed,
-        constrained,
-        mech,
-        bulk,
-        surface,
+        model,
         fundamental,
         stable,
         dt,
@@ -454,18 +433,18 @@ fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcom
     let start = Instant::now();
     let integration = Integration {
         dt: p.dt,
-        lagged_forces: p.scene.solver.force_lag == crate::scene::ForceLag::Previous,
-        ramp: p.scene.loading.ramp,
-        t_ramp: p.scene.loading.ramp_fraction * p.t_end,
+        lagged_forces: p.model.scene.solver.force_lag == crate::scene::ForceLag::Previous,
+        ramp: p.model.scene.loading.ramp,
+        t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
     };
     let mut sim = Simulation::new(
-        p.particles.x0.clone(),
-        p.mech.clone(),
-        p.prescribed.clone(),
+        p.model.particles.x0.clone(),
+        p.model.mech.clone(),
+        p.model.prescribed.clone(),
         integration,
     );
-    let every = (p.steps / (p.scene.output.records - 1)).max(1);
-    let bar = if opts.progress && (p.steps as f64 * p.particles.len() as f64) > 2e7 {
+    let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
+    let bar = if opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7 {
         let b = indicatif::ProgressBar::new(p.steps as u64);
         b.set_style(
             indicatif::ProgressStyle::with_template(
@@ -483,7 +462,7 @@ fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcom
         amplitude: 0.0,
     };
     let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
-    let mut records = Vec::with_capacity(p.scene.output.records + 1);
+    let mut records = Vec::with_capacity(p.model.scene.output.records + 1);
     let mut failure = None;
     for n in 0..p.steps {
         let want = n % every == 0 || n + 1 == p.steps;
@@ -509,9 +488,12 @@ fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcom
     }
     let wall = start.elapsed().as_secs_f64();
     let x = sim.state.x.clone();
-    let displacement: Vec<Vector2<f64>> =
-        x.iter().zip(&p.particles.x0).map(|(a, b)| a - b).collect();
-    let stress = particle_stress(&p.mech, &p.particles.volume, &x);
+    let displacement: Vec<Vector2<f64>> = x
+        .iter()
+        .zip(&p.model.particles.x0)
+        .map(|(a, b)| a - b)
+        .collect();
+    let stress = particle_stress(&p.model.mech, &p.model.particles.volume, &x);
     let summary = summarise(
         &p,
         &records,
@@ -522,11 +504,11 @@ fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcom
     let outcome = Outcome {
         summary,
         records,
-        x0: p.particles.x0.clone(),
+        x0: p.model.particles.x0.clone(),
         displacement,
         stress,
-        groups: p.groups.clone(),
-        scene: p.scene.clone(),
+        groups: p.model.groups.clone(),
+        scene: p.model.scene.clone(),
     };
     Ok(outcome)
 }
@@ -555,18 +537,18 @@ fn summarise(
         .filter(|r| r.internal_j >= 0.01 * umax && umax > 0.0)
         .map(|r| r.kinetic_j / r.internal_j)
         .fold(0.0, f64::max);
-    let d = &p.scene.discretisation;
+    let d = &p.model.scene.discretisation;
     Summary {
-        scene: p.scene.name().to_string(),
-        description: p.scene.description.clone(),
+        scene: p.model.scene.name().to_string(),
+        description: p.model.scene.description.clone(),
         status: if failure.is_some() {
             "unstable".into()
         } else {
             "completed".into()
         },
         message: failure,
-        particles: p.particles.len(),
-        bonds: p.particles.bonds(),
+        particles: p.model.particles.len(),
+        bonds: p.model.particles.bonds(),
         steps: records.last().map(|r| r.step + 1).unwrap_or(0),
         dt_s: p.dt,
         dt_stable_s: p.stable.dt_stable,
@@ -589,10 +571,10 @@ fn summarise(
         internal_energy_j: last.internal_j,
         kinetic_energy_j: last.kinetic_j,
         max_kinetic_to_internal_energy: ratio,
-        force_lag: p.scene.solver.force_lag,
-        surface_correction: p.surface.clone(),
-        micro_modulus_a_bulk: p.bulk.a,
-        micro_modulus_b_bulk: p.bulk.b,
+        force_lag: p.model.scene.solver.force_lag,
+        surface_correction: p.model.surface.clone(),
+        micro_modulus_a_bulk: p.model.bulk.a,
+        micro_modulus_b_bulk: p.model.bulk.b,
         spacing_m: d.spacing,
         rotation_deg: d.rotation_deg,
         offset_m: d.offset,

@@ -51,12 +51,18 @@ internal = {internal_damping}
 /// Free length of the equivalent continuum bar: from the upper held row to the tip, plus
 /// the half row pitch that the tip row's particles stand for.
 fn free_length(p: &sppm::run::Prepared) -> f64 {
-    let root = &p.groups[0].members;
+    let root = &p.model.groups[0].members;
     let y_root = root
         .iter()
-        .map(|&i| p.particles.x0[i as usize].y)
+        .map(|&i| p.model.particles.x0[i as usize].y)
         .fold(f64::MIN, f64::max);
-    let y_tip = p.particles.x0.iter().map(|x| x.y).fold(f64::MIN, f64::max);
+    let y_tip = p
+        .model
+        .particles
+        .x0
+        .iter()
+        .map(|x| x.y)
+        .fold(f64::MIN, f64::max);
     y_tip - y_root + 0.25 * 3f64.sqrt() * L0
 }
 
@@ -69,17 +75,18 @@ fn released(p: &sppm::run::Prepared, lagged: bool, dt: f64) -> Simulation<2, 6> 
         t_ramp: 1.0,
     };
     let mut sim = Simulation::new(
-        p.particles.x0.clone(),
-        p.mech.clone(),
-        p.prescribed.clone(),
+        p.model.particles.x0.clone(),
+        p.model.mech.clone(),
+        p.model.prescribed.clone(),
         integ,
     );
-    let y_root = p.groups[0]
+    let y_root = p.model.groups[0]
         .members
         .iter()
-        .map(|&i| p.particles.x0[i as usize].y)
+        .map(|&i| p.model.particles.x0[i as usize].y)
         .fold(f64::MIN, f64::max);
     let u: Vec<Vector2<f64>> = p
+        .model
         .particles
         .x0
         .iter()
@@ -100,11 +107,12 @@ fn fundamental_period_matches_the_bar_and_the_free_vibration() {
     // O(L0/W) boundary effect that tests/elastic_plate.rs measures on the stiffness side).
     let pitch = 0.5 * 3f64.sqrt() * L0;
     let (ymin, ymax) = p
+        .model
         .particles
         .x0
         .iter()
         .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x.y), b.max(x.y)));
-    let mass_per_length = p.mech.mass.iter().sum::<f64>() / (ymax - ymin + pitch);
+    let mass_per_length = p.model.mech.mass.iter().sum::<f64>() / (ymax - ymin + pitch);
     let stiffness = E / (1.0 - 0.04) * 0.025 * 0.025;
     let analytic = 4.0 * l * (mass_per_length / stiffness).sqrt();
     let t1 = p.fundamental.period;
@@ -117,11 +125,11 @@ fn fundamental_period_matches_the_bar_and_the_free_vibration() {
     // free vibration: the tip of a bar released from uniform strain oscillates with period
     // 4L/c; measure it from the upward zero crossings of the tip displacement about its mean
     let mut sim = released(&p, false, p.dt);
-    let tip = (0..p.particles.len())
+    let tip = (0..p.model.particles.len())
         .max_by(|&a, &b| {
-            p.particles.x0[a]
+            p.model.particles.x0[a]
                 .y
-                .partial_cmp(&p.particles.x0[b].y)
+                .partial_cmp(&p.model.particles.x0[b].y)
                 .unwrap()
         })
         .unwrap();
@@ -129,7 +137,7 @@ fn fundamental_period_matches_the_bar_and_the_free_vibration() {
     let mut series = Vec::with_capacity(steps);
     for _ in 0..steps {
         sim.advance(None);
-        series.push(sim.state.x[tip].y - p.particles.x0[tip].y);
+        series.push(sim.state.x[tip].y - p.model.particles.x0[tip].y);
     }
     let mean = series.iter().sum::<f64>() / series.len() as f64;
     let crossings: Vec<f64> = (1..series.len())

@@ -183,33 +183,25 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     /// (before the swap).
     fn kinetic_energy_mid(&self) -> f64 {
         let st = &self.state;
-        let total: f64 = (0..self.x0.len())
-            .map(|i| 0.5 * self.mech.mass[i] * ((st.v[i] + st.v_next[i]) * 0.5).norm_squared())
-            .sum();
-        let held: f64 = self
-            .prescribed
-            .iter()
-            .map(|p| {
-                let i = p.particle as usize;
-                let vc = 0.5 * (st.v[i][p.component as usize] + st.v_next[i][p.component as usize]);
-                0.5 * self.mech.mass[i] * vc * vc
-            })
-            .sum();
-        total - held
+        self.kinetic_energy_of(|i| (st.v[i] + st.v_next[i]) * 0.5)
     }
 
     /// Kinetic energy of the free components from v^{n−½}.
     pub fn kinetic_energy(&self) -> f64 {
-        let st = &self.state;
+        self.kinetic_energy_of(|i| self.state.v[i])
+    }
+
+    /// ½·Σ m·v² over the components that are not prescribed (the machine moves those).
+    fn kinetic_energy_of(&self, v: impl Fn(usize) -> SVector<f64, D>) -> f64 {
         let total: f64 = (0..self.x0.len())
-            .map(|i| 0.5 * self.mech.mass[i] * st.v[i].norm_squared())
+            .map(|i| 0.5 * self.mech.mass[i] * v(i).norm_squared())
             .sum();
         let held: f64 = self
             .prescribed
             .iter()
             .map(|p| {
                 let i = p.particle as usize;
-                let vc = st.v[i][p.component as usize];
+                let vc = v(i)[p.component as usize];
                 0.5 * self.mech.mass[i] * vc * vc
             })
             .sum();

@@ -181,7 +181,6 @@ pub fn fundamental<const D: usize, const K: usize>(
     x0: &[SVector<f64, D>],
     constrained: &[[bool; D]],
 ) -> Result<Fundamental, ModalError> {
-    let n = x0.len();
     let mass = &mech.mass;
     let modes = mechanisms(x0, mass, constrained);
     if constrained.iter().all(|c| c.iter().all(|&b| b)) {
@@ -190,15 +189,7 @@ pub fn fundamental<const D: usize, const K: usize>(
     let mut op = LinearOperator::new(mech, x0);
     // Lanczos needs about as many steps as one CG solve (√ of the condition number, which
     // grows with (extent/L0)²): allow 100 per lattice spacing across the body.
-    let (mut lo, mut hi) = (x0[0], x0[0]);
-    for x in x0 {
-        lo = lo.inf(x);
-        hi = hi.sup(x);
-    }
-    let l0_min = (0..n)
-        .flat_map(|i| mech.bonds(i).map(|(_, _, il)| 1.0 / il))
-        .fold(f64::INFINITY, f64::min);
-    let max_steps = (100.0 * (hi - lo).norm() / l0_min) as usize + 2000;
+    let max_steps = (100.0 * extent_in_spacings(mech, x0)) as usize + 2000;
     let est = Lanczos {
         mass,
         constrained: Some(constrained),
@@ -341,15 +332,7 @@ pub fn conjugate_gradient<const D: usize, const K: usize>(
     w.p.clone_from(&w.zr);
     let mut rz = dot(&w.r, &w.zr);
     // CG needs O(√cond) iterations and cond grows with (extent/L0)²: allow 200 per spacing
-    let (mut lo, mut hi) = (x0[0], x0[0]);
-    for x in x0 {
-        lo = lo.inf(x);
-        hi = hi.sup(x);
-    }
-    let l0_min = (0..n)
-        .flat_map(|i| mech.bonds(i).map(|(_, _, il)| 1.0 / il))
-        .fold(f64::INFINITY, f64::min);
-    let max_cg = (200.0 * (hi - lo).norm() / l0_min) as usize + 500;
+    let max_cg = (200.0 * extent_in_spacings(mech, x0)) as usize + 500;
     for it in 0..max_cg {
         if dot(&w.r, &w.r).sqrt() <= tol * bnorm {
             return Ok(it);
@@ -433,4 +416,21 @@ fn precondition<const D: usize>(
     for ((z, r), d) in zr.iter_mut().zip(r).zip(diag) {
         *z = r.component_mul(d);
     }
+}
+
+/// The body's diagonal in units of its shortest bond: iterative solvers on the lattice need
+/// a number of iterations proportional to it (√ of the condition number).
+fn extent_in_spacings<const D: usize, const K: usize>(
+    mech: &Mechanics<D, K>,
+    x0: &[SVector<f64, D>],
+) -> f64 {
+    let (mut lo, mut hi) = (x0[0], x0[0]);
+    for x in x0 {
+        lo = lo.inf(x);
+        hi = hi.sup(x);
+    }
+    let l0_min = (0..x0.len())
+        .flat_map(|i| mech.bonds(i).map(|(_, _, il)| 1.0 / il))
+        .fold(f64::INFINITY, f64::min);
+    (hi - lo).norm() / l0_min
 }
