@@ -9,6 +9,12 @@
 //!    current unit vector e_ij, plus the bond damper (3.55), then central differences
 //!    (3.58) with the particle damper (3.56) taken semi-implicitly.
 //!
+//! Both passes have an explicit AVX path (`mod avx`, chosen at run time, no FMA) that treats
+//! four consecutive particles at once, one per lane, slot by slot; an empty slot is masked to
+//! add exactly zero. Per lane it performs the scalar code's IEEE operations in the same order,
+//! so its results are bit-identical to the scalar path, which serves chunk tails, CPUs without
+//! AVX and other architectures (checked by the test at the end of this file).
+//!
 //! Writing F_b through bθ uses that S_ji = S_ij, so F_s,ji never needs the neighbour's other
 //! bonds. `LAG = true` is the literal reading (A) of MODEL.md §4: the force from the previous
 //! step's positions drives this step.
@@ -58,6 +64,75 @@ impl<const D: usize> State<D> {
     }
 }
 
+/// Particles handled together, one per SIMD lane (see [`dilatation_block`]).
+const LANES: usize = 4;
+
+/// b_i·Σ_m S_im for particle i (scalar; chunk tails and reference).
+#[inline(always)]
+fn dilatation_one<const D: usize, const K: usize>(
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    i: usize,
+) -> f64 {
+    let xi = x[i];
+    let nb = &m.neighbours[i];
+    let il = &m.inv_l0[i];
+    let mut s = 0.0;
+    for k in 0..K {
+        let j = nb[k];
+        if j == crate::discretise::NONE {
+            continue;
+        }
+        // SAFETY: Mechanics::new checks every occupied slot indexes a particle.
+        let xj = unsafe { *x.get_unchecked(j as usize) };
+        s += total_stretch((xj - xi).norm(), il[k]);
+    }
+    m.b[i] * s
+}
+
+/// Whether the AVX block kernels can run on this CPU.
+#[inline]
+fn use_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Pass 1 over one chunk starting at particle `base`.
+#[inline(always)]
+fn dilatation_chunk<const D: usize, const K: usize>(
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    base: usize,
+    chunk: &mut [f64],
+    avx: bool,
+) {
+    assert!(base + chunk.len() <= m.len() && m.len() == x.len());
+    #[cfg(target_arch = "x86_64")]
+    let done = if avx {
+        let done = chunk.len() / LANES * LANES;
+        // SAFETY: AVX is available (`use_avx`); base + done ≤ m.len() = x.len() (asserted
+        // above) and Mechanics::new checks every occupied slot indexes a particle.
+        unsafe { avx::dilatation_chunk(m, x, base, &mut chunk[..done]) };
+        done
+    } else {
+        0
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = {
+        let _ = avx;
+        0
+    };
+    for (o, bt) in chunk.iter_mut().enumerate().skip(done) {
+        *bt = dilatation_one(m, x, base + o);
+    }
+}
+
 /// Pass 1: b_i·Σ_m S_im for every particle.
 pub fn pass_dilatation<const D: usize, const K: usize>(
     m: &Mechanics<D, K>,
@@ -65,28 +140,10 @@ pub fn pass_dilatation<const D: usize, const K: usize>(
     out: &mut [f64],
 ) {
     assert!(x.len() == m.len() && out.len() == m.len());
+    let avx = use_avx();
     out.par_chunks_mut(CHUNK)
         .enumerate()
-        .for_each(|(c, chunk)| {
-            let base = c * CHUNK;
-            for (o, bt) in chunk.iter_mut().enumerate() {
-                let i = base + o;
-                let xi = x[i];
-                let nb = &m.neighbours[i];
-                let il = &m.inv_l0[i];
-                let mut s = 0.0;
-                for k in 0..K {
-                    let j = nb[k];
-                    if j == crate::discretise::NONE {
-                        continue;
-                    }
-                    // SAFETY: Mechanics::new checks every occupied slot indexes a particle.
-                    let xj = unsafe { *x.get_unchecked(j as usize) };
-                    s += total_stretch((xj - xi).norm(), il[k]);
-                }
-                *bt = m.b[i] * s;
-            }
-        });
+        .for_each(|(c, chunk)| dilatation_chunk(m, x, c * CHUNK, chunk, avx));
 }
 
 /// Internal force on particle i at positions x with velocities v (bond dampers if `DAMP`);
@@ -139,6 +196,96 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
     (f, power)
 }
 
+/// The central-difference update of particle i given its internal force.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn update_one<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    v: &[SVector<f64, D>],
+    force_prev: &[SVector<f64, D>],
+    dt: f64,
+    i: usize,
+    f: SVector<f64, D>,
+    bond_power: f64,
+    xn: &mut SVector<f64, D>,
+    vn: &mut SVector<f64, D>,
+    dw: &mut f64,
+) {
+    let drive = if LAG { force_prev[i] } else { f };
+    let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
+    let vi = v[i];
+    let vnew = (vi * (1.0 - h) + drive * (dt * m.inv_mass[i])) / (1.0 + h);
+    *vn = vnew;
+    *xn = x[i] + vnew * dt;
+    if DAMP || h != 0.0 {
+        let vm = (vi + vnew) * 0.5;
+        *dw += dt * (bond_power + m.c_ex[i] * vm.norm_squared());
+    }
+}
+
+/// Pass 2 over one chunk starting at particle `base`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn update_chunk<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    v: &[SVector<f64, D>],
+    b_theta: &[f64],
+    force_prev: &[SVector<f64, D>],
+    dt: f64,
+    base: usize,
+    xn: &mut [SVector<f64, D>],
+    vn: &mut [SVector<f64, D>],
+    fo: &mut [SVector<f64, D>],
+    dw: &mut [f64],
+    avx: bool,
+) {
+    let len = xn.len();
+    let n = m.len();
+    assert!(base + len <= n && x.len() == n && v.len() == n && b_theta.len() == n);
+    assert!(force_prev.len() == n);
+    assert!(vn.len() == len && fo.len() == len && dw.len() == len);
+    #[cfg(target_arch = "x86_64")]
+    let done = if avx {
+        let done = len / LANES * LANES;
+        // SAFETY: AVX is available (`use_avx`); base + done ≤ n and every state array has n
+        // entries (asserted above); Mechanics::new checks every occupied slot indexes a
+        // particle.
+        unsafe {
+            avx::update_chunk::<D, K, LAG, DAMP>(
+                m,
+                x,
+                v,
+                b_theta,
+                force_prev,
+                dt,
+                base,
+                &mut xn[..done],
+                &mut vn[..done],
+                &mut fo[..done],
+                &mut dw[..done],
+            )
+        };
+        done
+    } else {
+        0
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = {
+        let _ = avx;
+        0
+    };
+    for o in done..len {
+        let i = base + o;
+        let (f, bond_power) = particle_force::<D, K, DAMP>(m, x, v, b_theta, i);
+        fo[o] = f;
+        update_one::<D, K, LAG, DAMP>(
+            m, x, v, force_prev, dt, i, f, bond_power, &mut xn[o], &mut vn[o], &mut dw[o],
+        );
+    }
+}
+
 /// Pass 2: forces and the central-difference update of every particle into x_next, v_next.
 pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     m: &Mechanics<D, K>,
@@ -163,11 +310,13 @@ pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: 
         v_next.len(),
         force.len(),
         force_prev.len(),
-        b_theta.len()
+        b_theta.len(),
+        damping_work.len()
     ]
     .iter()
     .all(|&l| l == n));
     let (x, v, b_theta, force_prev) = (&x[..], &v[..], &b_theta[..], &force_prev[..]);
+    let avx = use_avx();
     x_next
         .par_chunks_mut(CHUNK)
         .zip(v_next.par_chunks_mut(CHUNK))
@@ -175,22 +324,20 @@ pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: 
         .zip(damping_work.par_chunks_mut(CHUNK))
         .enumerate()
         .for_each(|(c, (((xn, vn), fo), dw))| {
-            let base = c * CHUNK;
-            for o in 0..xn.len() {
-                let i = base + o;
-                let (f, bond_power) = particle_force::<D, K, DAMP>(m, x, v, b_theta, i);
-                fo[o] = f;
-                let drive = if LAG { force_prev[i] } else { f };
-                let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
-                let vi = v[i];
-                let vnew = (vi * (1.0 - h) + drive * (dt * m.inv_mass[i])) / (1.0 + h);
-                vn[o] = vnew;
-                xn[o] = x[i] + vnew * dt;
-                if DAMP || h != 0.0 {
-                    let vm = (vi + vnew) * 0.5;
-                    dw[o] += dt * (bond_power + m.c_ex[i] * vm.norm_squared());
-                }
-            }
+            update_chunk::<D, K, LAG, DAMP>(
+                m,
+                x,
+                v,
+                b_theta,
+                force_prev,
+                dt,
+                c * CHUNK,
+                xn,
+                vn,
+                fo,
+                dw,
+                avx,
+            )
         });
 }
 
@@ -202,4 +349,415 @@ pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
 ) {
     pass_dilatation(m, &st.x, &mut st.b_theta);
     pass_update::<D, K, LAG, DAMP>(m, st, dt);
+}
+
+/// Explicit AVX (4 × f64) versions of the block kernels, one particle per lane. They perform
+/// per lane the same IEEE operations in the same order as the scalar code (no FMA), so the
+/// results are bit-identical to it.
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{Mechanics, LANES};
+    use crate::discretise::NONE;
+    use core::arch::x86_64::*;
+    use nalgebra::SVector;
+
+    const _: () = assert!(LANES == 4);
+
+    /// Component c of 4 vectors at rows i0..i0+4, one per lane.
+    ///
+    /// # Safety
+    /// AVX available; i0 + 4 ≤ x.len().
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn load_own<const D: usize>(x: &[SVector<f64, D>], i0: usize) -> [__m256d; D] {
+        let mut out = [_mm256_setzero_pd(); D];
+        if D == 2 && std::mem::size_of::<SVector<f64, D>>() == 16 {
+            let p = x.as_ptr().add(i0) as *const f64;
+            let a = _mm256_loadu_pd(p); // x0 y0 x1 y1
+            let b = _mm256_loadu_pd(p.add(4)); // x2 y2 x3 y3
+            let lo = _mm256_permute2f128_pd(a, b, 0x20); // x0 y0 x2 y2
+            let hi = _mm256_permute2f128_pd(a, b, 0x31); // x1 y1 x3 y3
+            out[0] = _mm256_unpacklo_pd(lo, hi);
+            out[1] = _mm256_unpackhi_pd(lo, hi);
+        } else {
+            for (c, o) in out.iter_mut().enumerate() {
+                *o = _mm256_set_pd(
+                    x.get_unchecked(i0 + 3)[c],
+                    x.get_unchecked(i0 + 2)[c],
+                    x.get_unchecked(i0 + 1)[c],
+                    x.get_unchecked(i0)[c],
+                );
+            }
+        }
+        out
+    }
+
+    /// Component c of the vectors at rows j[0..4], one per lane.
+    ///
+    /// # Safety
+    /// AVX available; every j < x.len().
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn gather_vec<const D: usize>(x: &[SVector<f64, D>], j: &[usize; 4]) -> [__m256d; D] {
+        let mut out = [_mm256_setzero_pd(); D];
+        if D == 2 && std::mem::size_of::<SVector<f64, D>>() == 16 {
+            let p = x.as_ptr() as *const f64;
+            let r = |l: usize| _mm_loadu_pd(p.add(2 * j[l]));
+            let a = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(0)), r(2), 1); // x0 y0 x2 y2
+            let b = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(1)), r(3), 1); // x1 y1 x3 y3
+            out[0] = _mm256_unpacklo_pd(a, b);
+            out[1] = _mm256_unpackhi_pd(a, b);
+        } else {
+            for (c, o) in out.iter_mut().enumerate() {
+                *o = _mm256_set_pd(
+                    x.get_unchecked(j[3])[c],
+                    x.get_unchecked(j[2])[c],
+                    x.get_unchecked(j[1])[c],
+                    x.get_unchecked(j[0])[c],
+                );
+            }
+        }
+        out
+    }
+
+    /// s[j[l]] per lane.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn gather(s: &[f64], j: &[usize; 4]) -> __m256d {
+        _mm256_set_pd(
+            *s.get_unchecked(j[3]),
+            *s.get_unchecked(j[2]),
+            *s.get_unchecked(j[1]),
+            *s.get_unchecked(j[0]),
+        )
+    }
+
+    /// Neighbours in slot k of particles i0..i0+4 (the particle itself where the slot is
+    /// empty) and the occupancy mask (all ones where occupied).
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn slot<const D: usize, const K: usize>(
+        m: &Mechanics<D, K>,
+        i0: usize,
+        k: usize,
+    ) -> ([usize; 4], __m256d, __m256d) {
+        let mut j = [0usize; 4];
+        let mut occ = [0i64; 4];
+        let mut il = [0.0; 4];
+        for l in 0..4 {
+            let jj = *m.neighbours.get_unchecked(i0 + l).get_unchecked(k);
+            let o = jj != NONE;
+            occ[l] = -(o as i64);
+            j[l] = if o { jj as usize } else { i0 + l };
+            il[l] = *m.inv_l0.get_unchecked(i0 + l).get_unchecked(k);
+        }
+        let mask = _mm256_castsi256_pd(_mm256_set_epi64x(occ[3], occ[2], occ[1], occ[0]));
+        (j, mask, _mm256_loadu_pd(il.as_ptr()))
+    }
+
+    /// d = x_j − x_i per component and |d| (components summed in order, as nalgebra does).
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn geometry<const D: usize>(
+        xi: &[__m256d; D],
+        xj: &[__m256d; D],
+    ) -> ([__m256d; D], __m256d) {
+        let mut d = [_mm256_setzero_pd(); D];
+        for c in 0..D {
+            d[c] = _mm256_sub_pd(xj[c], xi[c]);
+        }
+        let mut l2 = _mm256_mul_pd(d[0], d[0]);
+        for dc in d.iter().skip(1) {
+            l2 = _mm256_add_pd(l2, _mm256_mul_pd(*dc, *dc));
+        }
+        (d, _mm256_sqrt_pd(l2))
+    }
+
+    /// See `super::dilatation_block`.
+    ///
+    /// # Safety
+    /// AVX available; i0 + 4 ≤ m.len() = x.len(); every occupied slot indexes a particle.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    pub unsafe fn dilatation_block<const D: usize, const K: usize>(
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        i0: usize,
+        out: *mut f64,
+    ) {
+        let one = _mm256_set1_pd(1.0);
+        let xi = load_own(x, i0);
+        let mut s = _mm256_setzero_pd();
+        for k in 0..K {
+            let (j, occ, il) = slot(m, i0, k);
+            let (_, len) = geometry(&xi, &gather_vec(x, &j));
+            // total_stretch: len·(1/L0) − 1
+            let st = _mm256_sub_pd(_mm256_mul_pd(len, il), one);
+            s = _mm256_add_pd(s, _mm256_and_pd(st, occ));
+        }
+        let b = _mm256_loadu_pd(m.b.as_ptr().add(i0));
+        _mm256_storeu_pd(out, _mm256_mul_pd(b, s));
+    }
+
+    /// See `super::force_block`.
+    ///
+    /// # Safety
+    /// AVX available; i0 + 4 ≤ m.len(); x, v and b_theta have m.len() entries; every
+    /// occupied slot indexes a particle.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    pub unsafe fn force_block<const D: usize, const K: usize, const DAMP: bool>(
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        v: &[SVector<f64, D>],
+        b_theta: &[f64],
+        i0: usize,
+    ) -> ([[f64; 4]; D], [f64; 4]) {
+        let one = _mm256_set1_pd(1.0);
+        let half = _mm256_set1_pd(0.5);
+        let xi = load_own(x, i0);
+        let vi = if DAMP {
+            load_own(v, i0)
+        } else {
+            [_mm256_setzero_pd(); D]
+        };
+        let ai = _mm256_loadu_pd(m.a.as_ptr().add(i0));
+        let bti = _mm256_loadu_pd(b_theta.as_ptr().add(i0));
+        let ci = if DAMP {
+            _mm256_loadu_pd(m.c_in.as_ptr().add(i0))
+        } else {
+            _mm256_setzero_pd()
+        };
+        let mut f = [_mm256_setzero_pd(); D];
+        let mut power = _mm256_setzero_pd();
+        for k in 0..K {
+            let (j, occ, il) = slot(m, i0, k);
+            let (d, len) = geometry(&xi, &gather_vec(x, &j));
+            let rinv = _mm256_and_pd(_mm256_div_pd(one, len), occ);
+            let st = _mm256_and_pd(_mm256_sub_pd(_mm256_mul_pd(len, il), one), occ);
+            let aj = gather(&m.a, &j);
+            let btj = gather(b_theta, &j);
+            // 0.5 * ((ai + aj) * s + bti + btj)
+            let mut fb = _mm256_mul_pd(
+                half,
+                _mm256_add_pd(
+                    _mm256_add_pd(_mm256_mul_pd(_mm256_add_pd(ai, aj), st), bti),
+                    btj,
+                ),
+            );
+            let mut e = [_mm256_setzero_pd(); D];
+            for c in 0..D {
+                e[c] = _mm256_mul_pd(d[c], rinv);
+            }
+            if DAMP {
+                let cj = gather(&m.c_in, &j);
+                let c = _mm256_mul_pd(half, _mm256_add_pd(ci, cj));
+                let vj = gather_vec(v, &j);
+                let mut rate = _mm256_mul_pd(_mm256_sub_pd(vj[0], vi[0]), e[0]);
+                for cc in 1..D {
+                    rate = _mm256_add_pd(rate, _mm256_mul_pd(_mm256_sub_pd(vj[cc], vi[cc]), e[cc]));
+                }
+                fb = _mm256_add_pd(fb, _mm256_mul_pd(c, rate));
+                // 0.5 * c * rate * rate
+                power = _mm256_add_pd(
+                    power,
+                    _mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(half, c), rate), rate),
+                );
+            }
+            for c in 0..D {
+                f[c] = _mm256_add_pd(f[c], _mm256_mul_pd(e[c], fb));
+            }
+        }
+        let mut fo = [[0.0; 4]; D];
+        for c in 0..D {
+            _mm256_storeu_pd(fo[c].as_mut_ptr(), f[c]);
+        }
+        let mut po = [0.0; 4];
+        _mm256_storeu_pd(po.as_mut_ptr(), power);
+        (fo, po)
+    }
+
+    /// Pass 1 over whole blocks: `out` holds particles base.., a multiple of 4 of them.
+    ///
+    /// # Safety
+    /// AVX available; base + out.len() ≤ m.len() = x.len(); every occupied slot indexes a
+    /// particle.
+    #[target_feature(enable = "avx")]
+    pub unsafe fn dilatation_chunk<const D: usize, const K: usize>(
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        base: usize,
+        out: &mut [f64],
+    ) {
+        for o in (0..out.len()).step_by(4) {
+            dilatation_block(m, x, base + o, out.as_mut_ptr().add(o));
+        }
+    }
+
+    /// Pass 2 over whole blocks: the slices hold particles base.., a multiple of 4 of them.
+    ///
+    /// # Safety
+    /// AVX available; base + xn.len() ≤ m.len(); x, v, b_theta and force_prev have m.len()
+    /// entries, vn, fo and dw xn.len(); every occupied slot indexes a particle.
+    #[allow(clippy::too_many_arguments)]
+    #[target_feature(enable = "avx")]
+    pub unsafe fn update_chunk<
+        const D: usize,
+        const K: usize,
+        const LAG: bool,
+        const DAMP: bool,
+    >(
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        v: &[SVector<f64, D>],
+        b_theta: &[f64],
+        force_prev: &[SVector<f64, D>],
+        dt: f64,
+        base: usize,
+        xn: &mut [SVector<f64, D>],
+        vn: &mut [SVector<f64, D>],
+        fo: &mut [SVector<f64, D>],
+        dw: &mut [f64],
+    ) {
+        for o0 in (0..xn.len()).step_by(4) {
+            let (f, power) = force_block::<D, K, DAMP>(m, x, v, b_theta, base + o0);
+            for l in 0..4 {
+                let o = o0 + l;
+                let fl = SVector::<f64, D>::from_fn(|c, _| f[c][l]);
+                *fo.get_unchecked_mut(o) = fl;
+                super::update_one::<D, K, LAG, DAMP>(
+                    m,
+                    x,
+                    v,
+                    force_prev,
+                    dt,
+                    base + o,
+                    fl,
+                    power[l],
+                    xn.get_unchecked_mut(o),
+                    vn.get_unchecked_mut(o),
+                    dw.get_unchecked_mut(o),
+                );
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::discretise::NONE;
+
+    /// Deterministic pseudo-random numbers in [0, 1).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// A random model with some empty slots and a random state, n not a multiple of the
+    /// chunk or block size.
+    fn model<const D: usize, const K: usize>(n: usize) -> (Mechanics<D, K>, State<D>) {
+        let mut r = Lcg(12345);
+        let x0: Vec<SVector<f64, D>> = (0..n)
+            .map(|i| SVector::from_fn(|c, _| i as f64 * 1e-3 * (c + 1) as f64 + 1e-4 * r.next()))
+            .collect();
+        let mut neighbours = vec![[NONE; K]; n];
+        let mut inv_l0 = vec![[0.0; K]; n];
+        for i in 0..n {
+            for k in 0..K {
+                if r.next() < 0.8 {
+                    let mut j = (i + 1 + (r.next() * 40.0) as usize) % n;
+                    if j == i {
+                        j = (i + 1) % n;
+                    }
+                    neighbours[i][k] = j as u32;
+                    inv_l0[i][k] = 1.0 / ((x0[j] - x0[i]).norm() * (1.0 + 0.01 * r.next()));
+                }
+            }
+        }
+        let mut v = |s: f64| (0..n).map(|_| s * (1.0 + r.next())).collect::<Vec<f64>>();
+        let (a, b, mass, c_in, c_ex) = (v(3e6), v(-1e5), v(1e-3), v(10.0), v(1.0));
+        let mech = Mechanics {
+            neighbours,
+            inv_l0,
+            a,
+            b,
+            inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
+            mass,
+            c_in,
+            c_ex,
+        };
+        let mut st = State::at_rest(&x0);
+        for i in 0..n {
+            st.v[i] = SVector::from_fn(|_, _| r.next() - 0.5);
+            st.force_prev[i] = SVector::from_fn(|_, _| r.next() - 0.5);
+            st.damping_work[i] = r.next();
+        }
+        (mech, st)
+    }
+
+    /// The kernel against the plain per-particle code, bit for bit, on 1 and 2 threads.
+    fn check<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>() {
+        let n = 2 * CHUNK + 4 * 37 + 3;
+        let (m, st0) = model::<D, K>(n);
+        let dt = 1e-7;
+        let mut want = st0.clone();
+        for i in 0..n {
+            want.b_theta[i] = dilatation_one(&m, &st0.x, i);
+        }
+        for i in 0..n {
+            let (f, p) = particle_force::<D, K, DAMP>(&m, &st0.x, &st0.v, &want.b_theta, i);
+            want.force[i] = f;
+            let (mut xn, mut vn, mut dw) = (st0.x_next[i], st0.v_next[i], st0.damping_work[i]);
+            update_one::<D, K, LAG, DAMP>(
+                &m,
+                &st0.x,
+                &st0.v,
+                &st0.force_prev,
+                dt,
+                i,
+                f,
+                p,
+                &mut xn,
+                &mut vn,
+                &mut dw,
+            );
+            (want.x_next[i], want.v_next[i], want.damping_work[i]) = (xn, vn, dw);
+        }
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut st = st0.clone();
+            pool.install(|| step::<D, K, LAG, DAMP>(&m, &mut st, dt));
+            let bits = |v: &[SVector<f64, D>]| {
+                v.iter()
+                    .flat_map(|p| p.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
+                    .collect::<Vec<_>>()
+            };
+            let sbits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
+            assert_eq!(sbits(&st.b_theta), sbits(&want.b_theta));
+            assert_eq!(bits(&st.force), bits(&want.force));
+            assert_eq!(bits(&st.x_next), bits(&want.x_next));
+            assert_eq!(bits(&st.v_next), bits(&want.v_next));
+            assert_eq!(sbits(&st.damping_work), sbits(&want.damping_work));
+        }
+    }
+
+    #[test]
+    fn step_matches_scalar_reference_bitwise() {
+        check::<2, 6, false, true>();
+        check::<2, 6, false, false>();
+        check::<2, 6, true, true>();
+        check::<2, 6, true, false>();
+        check::<3, 18, false, true>();
+        check::<3, 18, true, false>();
+    }
 }
