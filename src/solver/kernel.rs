@@ -24,8 +24,16 @@ use crate::model::stretch::total_stretch;
 use nalgebra::SVector;
 use rayon::prelude::*;
 
-/// Particles per parallel work item.
+/// Largest number of particles per parallel work item.
 pub const CHUNK: usize = 2048;
+
+/// Particles per parallel work item: about eight items per thread, so that a small scene
+/// (a few thousand particles) still keeps every thread busy, at most [`CHUNK`] and a multiple
+/// of the SIMD width. Chunking never changes results: each particle's update is independent.
+pub fn chunk_len(n: usize) -> usize {
+    let per_item = n.div_ceil(8 * rayon::current_num_threads().max(1));
+    (per_item.div_ceil(LANES) * LANES).clamp(64, CHUNK)
+}
 
 /// Dynamic state, allocated once.
 #[derive(Clone, Debug)]
@@ -141,9 +149,10 @@ pub fn pass_dilatation<const D: usize, const K: usize>(
 ) {
     assert!(x.len() == m.len() && out.len() == m.len());
     let avx = use_avx();
-    out.par_chunks_mut(CHUNK)
+    let chunk = chunk_len(out.len());
+    out.par_chunks_mut(chunk)
         .enumerate()
-        .for_each(|(c, chunk)| dilatation_chunk(m, x, c * CHUNK, chunk, avx));
+        .for_each(|(c, items)| dilatation_chunk(m, x, c * chunk, items, avx));
 }
 
 /// Internal force on particle i at positions x with velocities v (bond dampers if `DAMP`);
@@ -317,11 +326,12 @@ pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: 
     .all(|&l| l == n));
     let (x, v, b_theta, force_prev) = (&x[..], &v[..], &b_theta[..], &force_prev[..]);
     let avx = use_avx();
+    let chunk = chunk_len(n);
     x_next
-        .par_chunks_mut(CHUNK)
-        .zip(v_next.par_chunks_mut(CHUNK))
-        .zip(force.par_chunks_mut(CHUNK))
-        .zip(damping_work.par_chunks_mut(CHUNK))
+        .par_chunks_mut(chunk)
+        .zip(v_next.par_chunks_mut(chunk))
+        .zip(force.par_chunks_mut(chunk))
+        .zip(damping_work.par_chunks_mut(chunk))
         .enumerate()
         .for_each(|(c, (((xn, vn), fo), dw))| {
             update_chunk::<D, K, LAG, DAMP>(
@@ -331,7 +341,7 @@ pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: 
                 b_theta,
                 force_prev,
                 dt,
-                c * CHUNK,
+                c * chunk,
                 xn,
                 vn,
                 fo,
