@@ -9,7 +9,7 @@ cargo build --release --quiet
 bin=target/release/sppm
 printf '%-10s %-8s %-7s %-22s %s\n' particles threads steps "median particle-steps/s" "all runs"
 for n in 10000 100000 1000000; do
-  steps=$(( 20000000 / n )); [ "$steps" -lt 20 ] && steps=20
+  steps=$(( 50000000 / n )); [ "$steps" -lt 50 ] && steps=50
   for t in 1 2; do
     runs=()
     for _ in $(seq "$repeats"); do
