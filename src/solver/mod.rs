@@ -72,6 +72,8 @@ pub struct Simulation<const D: usize, const K: usize> {
     external_work: f64,
     /// Initial energy (free-vibration starts), for the blow-up test.
     energy_scale: f64,
+    /// Whether the kernel with bond dampers runs (decided once, before the loop).
+    bond_dampers: bool,
 }
 
 impl<const D: usize, const K: usize> Simulation<D, K> {
@@ -82,6 +84,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         integration: Integration,
     ) -> Self {
         let state = State::at_rest(&x0);
+        let bond_dampers = mech.has_bond_dampers();
         Simulation {
             x0,
             mech,
@@ -91,6 +94,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             step: 0,
             external_work: 0.0,
             energy_scale: 0.0,
+            bond_dampers,
         }
     }
 
@@ -115,8 +119,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     /// Advance one step. Returns the probe record when `record` is given.
     pub fn advance(&mut self, record: Option<&Probe>) -> Option<Record> {
         let dt = self.integration.dt;
-        let damp = self.mech.has_bond_dampers();
-        match (self.integration.lagged_forces, damp) {
+        match (self.integration.lagged_forces, self.bond_dampers) {
             (false, false) => kernel::step::<D, K, false, false>(&self.mech, &mut self.state, dt),
             (false, true) => kernel::step::<D, K, false, true>(&self.mech, &mut self.state, dt),
             (true, false) => kernel::step::<D, K, true, false>(&self.mech, &mut self.state, dt),

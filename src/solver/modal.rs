@@ -202,9 +202,6 @@ pub fn fundamental<const D: usize, const K: usize>(
         op.internal_forces(u, out);
         out.iter_mut().for_each(|v| *v = -*v);
     });
-    if std::env::var("SPPM_DEBUG").is_ok() {
-        eprintln!("fundamental mode: {est:?}");
-    }
     if !est.converged || est.eigenvalue.is_nan() || est.eigenvalue <= 0.0 {
         return Err(ModalError::Failed(format!(
             "Lanczos did not converge in {} steps (estimate ω1² = {:e})",
