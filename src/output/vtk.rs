@@ -1,5 +1,6 @@
-//! Legacy binary VTK (POLYDATA, one vertex per particle) for ParaView, with displacement,
-//! stress, von Mises stress, bond count and group membership as point data.
+//! Legacy binary VTK (an unstructured grid of vertex cells, one per particle) for ParaView,
+//! with displacement, stress tensor, von Mises and maximum principal stress, and group
+//! membership as point data. Checked with meshio's reader.
 
 use super::fields;
 use crate::run::Outcome;
@@ -19,16 +20,21 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     let n = o.x0.len();
     writeln!(w, "# vtk DataFile Version 3.0")?;
     writeln!(w, "sppm {} particles", o.summary.scene)?;
-    writeln!(w, "BINARY\nDATASET POLYDATA\nPOINTS {n} float")?;
+    writeln!(w, "BINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS {n} float")?;
     for x in &o.x0 {
         be(&mut w, x.x)?;
         be(&mut w, x.y)?;
         be(&mut w, 0.0)?;
     }
-    writeln!(w, "\nVERTICES {n} {}", 2 * n)?;
+    writeln!(w, "\nCELLS {n} {}", 2 * n)?;
     for i in 0..n {
         w.write_all(&1i32.to_be_bytes())?;
         w.write_all(&(i as i32).to_be_bytes())?;
+    }
+    // cell type 1: VTK_VERTEX
+    writeln!(w, "\nCELL_TYPES {n}")?;
+    for _ in 0..n {
+        w.write_all(&1i32.to_be_bytes())?;
     }
     writeln!(w, "\nPOINT_DATA {n}\nVECTORS displacement_m float")?;
     for u in &o.displacement {
