@@ -86,6 +86,16 @@ impl<const D: usize, const K: usize> Particles<D, K> {
 pub const fn bytes_per_particle(d: usize, k: usize) -> usize {
     // x0, x, x_next, v, v_next, force, force_prev: 7·D f64; volume, mass, inv_mass, a, b,
     // c_in, c_ex, b·theta, damping energy: 9 f64; neighbours (u32), reverse (u8),
-    // l0 and 1/l0 (f64) per slot; group bookkeeping and outputs: ~64 bytes.
-    7 * d * 8 + 9 * 8 + k * (4 + 1 + 16) + 64
+    // l0 and 1/l0 (f64) and the kernel's cached stretch and 1/length (f64) per slot; group
+    // bookkeeping and outputs: ~64 bytes.
+    7 * d * 8 + 9 * 8 + k * (4 + 1 + 32) + 64
+}
+
+/// Slots per particle of the standard lattices: 6 for the 2D hexagonal lattice, 18 for 3D.
+pub const fn slots(d: usize) -> usize {
+    if d == 2 {
+        6
+    } else {
+        18
+    }
 }
