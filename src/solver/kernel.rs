@@ -291,15 +291,31 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
     (f, power)
 }
 
+/// What pass 2 reads: the model, the state at step n (and, with the bond cache, what pass 1
+/// left at the same positions) and the step size.
+#[derive(Clone, Copy)]
+struct Inputs<'a, const D: usize, const K: usize> {
+    m: &'a Mechanics<D, K>,
+    x: &'a [SVector<f64, D>],
+    v: &'a [SVector<f64, D>],
+    b_theta: &'a [f64],
+    force_prev: &'a [SVector<f64, D>],
+    cache: &'a [f64],
+    dt: f64,
+}
+
+/// What pass 2 writes for one chunk of particles.
+struct ChunkOut<'b, const D: usize> {
+    xn: &'b mut [SVector<f64, D>],
+    vn: &'b mut [SVector<f64, D>],
+    fo: &'b mut [SVector<f64, D>],
+    dw: &'b mut [f64],
+}
+
 /// The central-difference update of particle i given its internal force.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn update_one<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
-    m: &Mechanics<D, K>,
-    x: &[SVector<f64, D>],
-    v: &[SVector<f64, D>],
-    force_prev: &[SVector<f64, D>],
-    dt: f64,
+    inp: Inputs<'_, D, K>,
     i: usize,
     f: SVector<f64, D>,
     bond_power: f64,
@@ -307,6 +323,14 @@ fn update_one<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>
     vn: &mut SVector<f64, D>,
     dw: &mut f64,
 ) {
+    let Inputs {
+        m,
+        x,
+        v,
+        force_prev,
+        dt,
+        ..
+    } = inp;
     let drive = if LAG { force_prev[i] } else { f };
     let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
     let vi = v[i];
@@ -322,7 +346,6 @@ fn update_one<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>
 /// Pass 2 over one chunk starting at particle `base`; with `CACHE`, the AVX blocks take each
 /// slot's stretch and inverse length from `cache` (all of [`State::bond_cache`], filled by
 /// pass 1 at the same positions) instead of recomputing them.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn update_chunk<
     const D: usize,
@@ -331,20 +354,21 @@ fn update_chunk<
     const DAMP: bool,
     const CACHE: bool,
 >(
-    m: &Mechanics<D, K>,
-    x: &[SVector<f64, D>],
-    v: &[SVector<f64, D>],
-    b_theta: &[f64],
-    force_prev: &[SVector<f64, D>],
-    cache: &[f64],
-    dt: f64,
+    inp: Inputs<'_, D, K>,
     base: usize,
-    xn: &mut [SVector<f64, D>],
-    vn: &mut [SVector<f64, D>],
-    fo: &mut [SVector<f64, D>],
-    dw: &mut [f64],
+    out: ChunkOut<'_, D>,
     avx: bool,
 ) {
+    let Inputs {
+        m,
+        x,
+        v,
+        b_theta,
+        force_prev,
+        cache,
+        ..
+    } = inp;
+    let ChunkOut { xn, vn, fo, dw } = out;
     let len = xn.len();
     let n = m.len();
     assert!(base + len <= n && x.len() == n && v.len() == n && b_theta.len() == n);
@@ -359,18 +383,14 @@ fn update_chunk<
         // occupied slot indexes a particle.
         unsafe {
             avx::update_chunk::<D, K, LAG, DAMP, CACHE>(
-                m,
-                x,
-                v,
-                b_theta,
-                force_prev,
-                cache,
-                dt,
+                inp,
                 base,
-                &mut xn[..done],
-                &mut vn[..done],
-                &mut fo[..done],
-                &mut dw[..done],
+                ChunkOut {
+                    xn: &mut xn[..done],
+                    vn: &mut vn[..done],
+                    fo: &mut fo[..done],
+                    dw: &mut dw[..done],
+                },
             )
         };
         done
@@ -386,9 +406,7 @@ fn update_chunk<
         let i = base + o;
         let (f, bond_power) = particle_force::<D, K, DAMP>(m, x, v, b_theta, i);
         fo[o] = f;
-        update_one::<D, K, LAG, DAMP>(
-            m, x, v, force_prev, dt, i, f, bond_power, &mut xn[o], &mut vn[o], &mut dw[o],
-        );
+        update_one::<D, K, LAG, DAMP>(inp, i, f, bond_power, &mut xn[o], &mut vn[o], &mut dw[o]);
     }
 }
 
@@ -449,7 +467,7 @@ fn pass_update_impl<
         .zip(damping_work.par_chunks_mut(chunk))
         .enumerate()
         .for_each(|(c, (((xn, vn), fo), dw))| {
-            update_chunk::<D, K, LAG, DAMP, CACHE>(
+            let inp = Inputs {
                 m,
                 x,
                 v,
@@ -457,13 +475,8 @@ fn pass_update_impl<
                 force_prev,
                 cache,
                 dt,
-                c * chunk,
-                xn,
-                vn,
-                fo,
-                dw,
-                avx,
-            )
+            };
+            update_chunk::<D, K, LAG, DAMP, CACHE>(inp, c * chunk, ChunkOut { xn, vn, fo, dw }, avx)
         });
 }
 
@@ -489,7 +502,7 @@ pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
 /// results are bit-identical to it.
 #[cfg(target_arch = "x86_64")]
 mod avx {
-    use super::{bond_cache_at, Mechanics, LANES};
+    use super::{bond_cache_at, ChunkOut, Inputs, Mechanics, LANES};
     use crate::discretise::NONE;
     use core::arch::x86_64::*;
     use nalgebra::SVector;
@@ -777,28 +790,28 @@ mod avx {
     /// AVX available; base + xn.len() ≤ m.len(); x, v, b_theta and force_prev have m.len()
     /// entries, vn, fo and dw xn.len(); every occupied slot indexes a particle; with `CACHE`,
     /// cache is the whole bond cache, filled by pass 1 at positions x.
-    #[allow(clippy::too_many_arguments)]
     #[target_feature(enable = "avx")]
-    pub unsafe fn update_chunk<
+    pub(super) unsafe fn update_chunk<
         const D: usize,
         const K: usize,
         const LAG: bool,
         const DAMP: bool,
         const CACHE: bool,
     >(
-        m: &Mechanics<D, K>,
-        x: &[SVector<f64, D>],
-        v: &[SVector<f64, D>],
-        b_theta: &[f64],
-        force_prev: &[SVector<f64, D>],
-        cache: &[f64],
-        dt: f64,
+        inp: Inputs<'_, D, K>,
         base: usize,
-        xn: &mut [SVector<f64, D>],
-        vn: &mut [SVector<f64, D>],
-        fo: &mut [SVector<f64, D>],
-        dw: &mut [f64],
+        out: ChunkOut<'_, D>,
     ) {
+        let Inputs {
+            m,
+            x,
+            v,
+            b_theta,
+            force_prev,
+            cache,
+            dt,
+        } = inp;
+        let ChunkOut { xn, vn, fo, dw } = out;
         let vector_update = D == 2 && std::mem::size_of::<SVector<f64, D>>() == 16;
         let one = _mm256_set1_pd(1.0);
         let half = _mm256_set1_pd(0.5);
@@ -867,11 +880,7 @@ mod avx {
                 let fl = SVector::<f64, D>::from_fn(|c, _| fa[c][l]);
                 *fo.get_unchecked_mut(o) = fl;
                 super::update_one::<D, K, LAG, DAMP>(
-                    m,
-                    x,
-                    v,
-                    force_prev,
-                    dt,
+                    inp,
                     i0 + l,
                     fl,
                     pa[l],
@@ -960,19 +969,16 @@ mod tests {
             let (f, p) = particle_force::<D, K, DAMP>(&m, &st0.x, &st0.v, &want.b_theta, i);
             want.force[i] = f;
             let (mut xn, mut vn, mut dw) = (st0.x_next[i], st0.v_next[i], st0.damping_work[i]);
-            update_one::<D, K, LAG, DAMP>(
-                &m,
-                &st0.x,
-                &st0.v,
-                &st0.force_prev,
+            let inp = Inputs {
+                m: &m,
+                x: &st0.x,
+                v: &st0.v,
+                b_theta: &want.b_theta,
+                force_prev: &st0.force_prev,
+                cache: &[],
                 dt,
-                i,
-                f,
-                p,
-                &mut xn,
-                &mut vn,
-                &mut dw,
-            );
+            };
+            update_one::<D, K, LAG, DAMP>(inp, i, f, p, &mut xn, &mut vn, &mut dw);
             (want.x_next[i], want.v_next[i], want.damping_work[i]) = (xn, vn, dw);
         }
         for threads in [1, 2] {
