@@ -112,7 +112,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Check { scene, set } => {
             let sc = Scene::from_file(&scene, &set)?;
             let mem = estimated_memory(&sc);
-            let p = prepare(&sc)?;
+            let mut p = prepare(&sc)?;
             // calibrate the run time with a few steps of the real kernel
             let probe = sppm::solver::Integration {
                 dt: p.dt,
@@ -122,8 +122,8 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             };
             let mut sim = sppm::solver::Simulation::new(
                 p.model.particles.x0.clone(),
-                p.model.mech.clone(),
-                p.model.prescribed.clone(),
+                std::mem::take(&mut p.model.mech),
+                std::mem::take(&mut p.model.prescribed),
                 probe,
             );
             let calib = 20.min(p.steps.max(1));

@@ -429,7 +429,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
     pool.install(|| run_prepared(prepare(scene)?, opts, threads))
 }
 
-fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
+fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let integration = Integration {
         dt: p.dt,
@@ -437,10 +437,11 @@ fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcom
         ramp: p.model.scene.loading.ramp,
         t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
     };
+    // the simulation takes the model's arrays over rather than copying them
     let mut sim = Simulation::new(
         p.model.particles.x0.clone(),
-        p.model.mech.clone(),
-        p.model.prescribed.clone(),
+        std::mem::take(&mut p.model.mech),
+        std::mem::take(&mut p.model.prescribed),
         integration,
     );
     let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
@@ -493,7 +494,7 @@ fn run_prepared(p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcom
         .zip(&p.model.particles.x0)
         .map(|(a, b)| a - b)
         .collect();
-    let stress = particle_stress(&p.model.mech, &p.model.particles.volume, &x);
+    let stress = particle_stress(&sim.mech, &p.model.particles.volume, &x);
     let summary = summarise(
         &p,
         &records,

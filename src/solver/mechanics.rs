@@ -5,7 +5,7 @@ use crate::discretise::{Particles, NONE};
 use nalgebra::SVector;
 
 /// The assembled SPLM model of one run.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Mechanics<const D: usize, const K: usize> {
     pub neighbours: Vec<[u32; K]>,
     pub inv_l0: Vec<[f64; K]>,
