@@ -19,29 +19,28 @@ fn tmp(name: &str) -> std::path::PathBuf {
     d
 }
 
-const FAST: [&str; 4] = [
-    "--set",
-    "discretisation.spacing=0.005",
-    "--set",
-    "loading.end_periods=3",
-];
+/// `sppm run` of the shipped plate, coarsened and shortened, into `out`, with extra options.
+fn run_plate(out: &Path, extra: &[&str]) -> std::process::Output {
+    let fast = [
+        "--set",
+        "discretisation.spacing=0.005",
+        "--set",
+        "loading.end_periods=3",
+    ];
+    let head = [
+        "run",
+        "lattices/elastic_plate.toml",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    sppm(&[&head[..], &fast[..], extra].concat())
+}
 
 #[test]
 fn run_writes_every_output() {
     let out = tmp("run");
-    let o = sppm(
-        &[
-            &[
-                "run",
-                "lattices/elastic_plate.toml",
-                "--quiet",
-                "--out",
-                out.to_str().unwrap(),
-            ][..],
-            &FAST[..],
-        ]
-        .concat(),
-    );
+    let o = run_plate(&out, &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for f in [
         "summary.json",
@@ -180,21 +179,7 @@ fn bad_input_stops_with_the_key_and_a_non_zero_status() {
 #[test]
 fn an_unstable_run_names_step_and_particle() {
     let out = tmp("unstable");
-    let o = sppm(
-        &[
-            &[
-                "run",
-                "lattices/elastic_plate.toml",
-                "--quiet",
-                "--out",
-                out.to_str().unwrap(),
-                "--set",
-                "solver.force_lag=previous",
-            ][..],
-            &FAST[..],
-        ]
-        .concat(),
-    );
+    let o = run_plate(&out, &["--set", "solver.force_lag=previous"]);
     assert_eq!(o.status.code(), Some(3));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(

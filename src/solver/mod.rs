@@ -102,8 +102,9 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         self.step as f64 * self.integration.dt
     }
 
-    fn prescribed_at(&self, p: &Prescribed, t: f64) -> f64 {
-        p.amplitude * ramp_fraction(self.integration.ramp, t, self.integration.t_ramp)
+    /// Fraction of Δmax applied at time t.
+    fn ramp_at(&self, t: f64) -> f64 {
+        ramp_fraction(self.integration.ramp, t, self.integration.t_ramp)
     }
 
     /// Start from a given displacement field and velocity (free-vibration tests).
@@ -126,13 +127,19 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             (true, true) => kernel::step::<D, K, true, true>(&self.mech, &mut self.state, dt),
         }
         let t = self.time();
-        let (t_prev, t_next) = (t - dt, t + dt);
+        // The ramp at n−1, n and n+1, once for every prescribed component.
+        let r_prev = if self.step == 0 {
+            0.0
+        } else {
+            self.ramp_at(t - dt)
+        };
+        let (r_now, r_next) = (self.ramp_at(t), self.ramp_at(t + dt));
         // Supports and displacement loading; work of the reactions (central rule).
         let mut work = 0.0;
         let mut work_half = 0.0;
         for p in &self.prescribed {
             let (i, c) = (p.particle as usize, p.component as usize);
-            let u_next = self.prescribed_at(p, t_next);
+            let u_next = p.amplitude * r_next;
             // The kernel integrated this component freely and booked its particle-damper
             // work; no particle damper acts on a prescribed component: take that work back.
             let c_ex = self.mech.c_ex[i];
@@ -144,14 +151,9 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             self.state.v_next[i][c] = (self.state.x_next[i][c] - self.state.x[i][c]) / dt;
             if p.amplitude != 0.0 {
                 let reaction = -self.state.force[i][c];
-                let u_prev = if self.step == 0 {
-                    0.0
-                } else {
-                    self.prescribed_at(p, t_prev)
-                };
-                let u_now = self.prescribed_at(p, t);
+                let u_prev = p.amplitude * r_prev;
                 work += reaction * 0.5 * (u_next - u_prev);
-                work_half += reaction * 0.5 * (u_now - u_prev);
+                work_half += reaction * 0.5 * (p.amplitude * r_now - u_prev);
             }
         }
         let rec = record.map(|probe| {
@@ -159,8 +161,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             Record {
                 step: self.step,
                 time_s: t,
-                displacement_m: probe.amplitude
-                    * ramp_fraction(self.integration.ramp, t, self.integration.t_ramp),
+                displacement_m: probe.amplitude * r_now,
                 force_n: -probe
                     .members
                     .iter()
@@ -230,11 +231,6 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 0.25 * (m.a[i] * sum_s2_l + m.b[i] * sum_s * sum_s_l)
             })
             .sum()
-    }
-
-    /// Total work of the supports and the loading so far (J).
-    pub fn external_work(&self) -> f64 {
-        self.external_work
     }
 
     /// Stop with the step and the particle if the state is not finite, or if the kinetic
