@@ -1,5 +1,6 @@
-//! `sppm bench`: throughput of the elastic step kernel on a square block of hexagonal
-//! lattice, in particle-steps per second (set-up excluded).
+//! `sppm bench`: throughput of the step kernels (elastic, or with concrete damage and
+//! plasticity) on a square block of hexagonal lattice, in particle-steps per second (set-up
+//! excluded).
 
 use crate::discretise::hex::HexLattice;
 use crate::geometry::Shape2;
@@ -29,6 +30,25 @@ pub fn bench_elastic(
     steps: usize,
     threads: usize,
 ) -> anyhow::Result<BenchResult> {
+    bench(particles, steps, threads, false)
+}
+
+/// [`bench_elastic`] with the concrete kernel (damage and plasticity on, the Table 1
+/// concrete of 002, strained to 90% of f't/E so that every particle evaluates its criteria).
+pub fn bench_concrete(
+    particles: usize,
+    steps: usize,
+    threads: usize,
+) -> anyhow::Result<BenchResult> {
+    bench(particles, steps, threads, true)
+}
+
+fn bench(
+    particles: usize,
+    steps: usize,
+    threads: usize,
+    concrete: bool,
+) -> anyhow::Result<BenchResult> {
     let l0 = 1e-3;
     let side = (particles as f64 * 0.5 * 3f64.sqrt()).sqrt() * l0;
     let shape = Shape2::Rectangle {
@@ -54,23 +74,53 @@ pub fn bench_elastic(
     let dt = 0.9 * crate::solver::time_step::stable_step(&mech, &p.x0).dt_stable;
     let mut st = State::at_rest(&p.x0);
     // a small homogeneous strain so that every bond works
+    let strain = if concrete { 0.9e-4 } else { 1e-4 };
     for (x, x0) in st.x.iter_mut().zip(&p.x0) {
-        *x = x0 * (1.0 + 1e-4);
+        *x = x0 * (1.0 + strain);
     }
+    let mut model = concrete.then(|| {
+        let law = crate::model::damage::ConcreteLaw {
+            e: 30e9,
+            nu: 0.2,
+            plane: Plane::Stress,
+            fc: 27.58e6,
+            ft: 2.6168e6,
+            fy: 22.983e6,
+            fult: 27.58e6,
+            gf: 81.4,
+            cod_c: 1.778e-4,
+            cod_1: 1.778e-5,
+            gamma: 0.25,
+            eps_ult: 0.0035,
+            wt_cr: 1.0 / 3.0,
+            wc_max: 1.0,
+            initiation: crate::scene::Initiation::Rankine,
+            crack_opening: crate::scene::CrackOpening::Total,
+            tensile_damage: true,
+            compressive_damage: true,
+            plasticity: true,
+            crack_band: 2.8 * l0,
+        };
+        crate::solver::concrete::Concrete::new(law, &p)
+    });
+    let mut one_step = |st: &mut State<2>| {
+        match model.as_mut() {
+            Some(c) => crate::solver::concrete::step::<6, false, true>(&mech, c, st, dt),
+            None => kernel::step::<2, 6, false, true>(&mech, st, dt),
+        }
+        std::mem::swap(&mut st.x, &mut st.x_next);
+        std::mem::swap(&mut st.v, &mut st.v_next);
+    };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
     let seconds = pool.install(|| {
         for _ in 0..2 {
-            kernel::step::<2, 6, false, true>(&mech, &mut st, dt);
-            std::mem::swap(&mut st.x, &mut st.x_next);
-            std::mem::swap(&mut st.v, &mut st.v_next);
+            one_step(&mut st);
         }
         let t = Instant::now();
         for _ in 0..steps {
-            kernel::step::<2, 6, false, true>(&mech, &mut st, dt);
-            std::mem::swap(&mut st.x, &mut st.x_next);
-            std::mem::swap(&mut st.v, &mut st.v_next);
+            one_step(&mut st);
         }
         t.elapsed().as_secs_f64()
     });
@@ -78,7 +128,7 @@ pub fn bench_elastic(
         particles: n,
         steps,
         threads,
-        model: "elastic".into(),
+        model: if concrete { "concrete" } else { "elastic" }.into(),
         particle_steps_per_s: (n * steps) as f64 / seconds,
         seconds,
     })

@@ -53,7 +53,7 @@ enum Command {
         steps: usize,
         #[arg(long, default_value_t = 1)]
         threads: usize,
-        /// Kernel: elastic (damage kernels arrive with the concrete model).
+        /// Kernel: "elastic", or "concrete" (two-spring damage and plasticity).
         #[arg(long, default_value = "elastic")]
         model: String,
     },
@@ -113,19 +113,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             let sc = Scene::from_file(&scene, &set)?;
             let mem = estimated_memory(&sc);
             let mut p = prepare(&sc)?;
-            // calibrate the run time with a few steps of the real kernel
-            let probe = sppm::solver::Integration {
-                dt: p.dt,
-                lagged_forces: sc.solver.force_lag == sppm::scene::ForceLag::Previous,
-                ramp: sc.loading.ramp,
-                t_ramp: sc.loading.ramp_fraction * p.t_end,
-            };
-            let mut sim = sppm::solver::Simulation::new(
-                p.model.particles.x0.clone(),
-                std::mem::take(&mut p.model.mech),
-                std::mem::take(&mut p.model.prescribed),
-                probe,
-            );
+            // calibrate the run time with a few steps of the real kernel (with damage and
+            // plasticity where the scene has them)
+            let mut sim = sppm::run::build_simulation(&mut p);
             let calib = 20.min(p.steps.max(1));
             let t = std::time::Instant::now();
             for _ in 0..calib {
@@ -159,6 +149,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 "surface corr.    {} of {} boundary particles",
                 p.model.surface.corrected, p.model.surface.boundary_particles
             );
+            for d in &sc.derived {
+                println!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);
+            }
             Ok(ExitCode::SUCCESS)
         }
         Command::Bench {
@@ -173,13 +166,17 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 "--dim {dim}: only 2 is available (3D arrives with the FCC lattice)"
             );
             anyhow::ensure!(
-                model == "elastic",
-                "--model {model}: only \"elastic\" is available until the damage kernels land"
+                model == "elastic" || model == "concrete",
+                "--model {model}: \"elastic\" or \"concrete\" (damage and plasticity)"
             );
             anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
             anyhow::ensure!(threads >= 1, "--threads {threads}: at least 1");
-            let r = sppm::bench::bench_elastic(particles, steps.max(1), threads)
-                .context("benchmark failed")?;
+            let r = if model == "concrete" {
+                sppm::bench::bench_concrete(particles, steps.max(1), threads)
+            } else {
+                sppm::bench::bench_elastic(particles, steps.max(1), threads)
+            }
+            .context("benchmark failed")?;
             println!("{}", serde_json::to_string(&r)?);
             Ok(ExitCode::SUCCESS)
         }

@@ -7,6 +7,7 @@ use crate::material;
 use crate::model::micro_modulus::{self, MicroModuli};
 use crate::model::stress::StressSum;
 use crate::scene::{Scene, SceneError};
+use crate::solver::concrete::{self, Concrete, ParticleDamage};
 use crate::solver::loading::Prescribed;
 use crate::solver::mechanics::Mechanics;
 use crate::solver::time_step::{stable_step, StableStep};
@@ -146,7 +147,7 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
         }
         let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
         if let Some(l) = &g.load {
-            entries.push((l.component.index(), l.displacement));
+            entries.push((l.component.index(), l.delta()));
         }
         for &i in &members {
             for &(c, amp) in &entries {
@@ -185,8 +186,8 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
         .collect();
 
     // Micro-moduli, with the surface correction of particles that miss bonds.
-    let bulk = micro_modulus::hexagonal(m.e, m.nu, d.spacing, m.thickness, m.plane);
-    let dmat = micro_modulus::elasticity_matrix(m.e, m.nu, m.plane);
+    let bulk = micro_modulus::hexagonal(m.youngs_modulus(), m.nu, d.spacing, m.thickness, m.plane);
+    let dmat = micro_modulus::elasticity_matrix(m.youngs_modulus(), m.nu, m.plane);
     let mut a = vec![bulk.a; n];
     let mut b = vec![bulk.b; n];
     let mut surface = SurfaceCorrection {
@@ -245,7 +246,7 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
     let m = &scene.material;
     let n = model.particles.len();
     let fundamental = modal::fundamental(&model.mech, &model.particles.x0, &model.constrained)?;
-    let omega_i = material::particle_frequency(m.e, m.nu, m.rho, d.spacing);
+    let omega_i = material::particle_frequency(m.youngs_modulus(), m.nu, m.rho, d.spacing);
     let omega_struct = 2.0 * std::f64::consts::PI / fundamental.period;
     let mech = &mut model.mech;
     for i in 0..n {
@@ -296,7 +297,7 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
             .members
             .clone();
         let (component, amplitude) = match &spec.load {
-            Some(l) => (l.component.index(), l.displacement),
+            Some(l) => (l.component.index(), l.delta()),
             None => (spec.fix[0].index(), 0.0),
         };
         (
@@ -356,9 +357,26 @@ pub struct Summary {
     pub internal_energy_j: f64,
     #[serde(rename = "kinetic_energy_J")]
     pub kinetic_energy_j: f64,
-    /// Largest kinetic/internal energy ratio over the records where the internal energy is at
-    /// least 1% of its maximum (the quasi-static check).
+    /// Largest kinetic/internal energy ratio before and around the peak (the records up to
+    /// the peak and after it while the force stays at 80% of the peak or more), over the records where the internal energy is
+    /// at least 1% of its maximum (the quasi-static check).
     pub max_kinetic_to_internal_energy: f64,
+    /// The same over the whole run (after complete failure the elastic energy vanishes and
+    /// this ratio says little).
+    pub max_kinetic_to_internal_energy_whole_run: f64,
+    /// Largest tensile damage w_t (scenes with `[concrete]`).
+    pub max_damage: Option<f64>,
+    pub max_compressive_damage: Option<f64>,
+    /// Particles with w_t ≥ 0.99.
+    pub cracked_particles: Option<usize>,
+    /// Particles with w_c ≥ 0.99.
+    pub crushed_particles: Option<usize>,
+    /// Particles that yielded at least once.
+    pub yielded_particles: Option<usize>,
+    /// The concrete law used (every value resolved).
+    pub concrete: Option<crate::model::damage::ConcreteLaw>,
+    /// Material values and where each came from (scene, preset or correlation).
+    pub material_values: Vec<crate::material::concrete::Derived>,
     pub force_lag: crate::scene::ForceLag,
     pub surface_correction: SurfaceCorrection,
     pub micro_modulus_a_bulk: f64,
@@ -380,6 +398,8 @@ pub struct Outcome {
     pub x0: Vec<Vector2<f64>>,
     pub displacement: Vec<Vector2<f64>>,
     pub stress: Vec<Matrix2<f64>>,
+    /// Damage and plasticity state of each particle at the end (scenes with `[concrete]`).
+    pub damage: Option<Vec<ParticleDamage>>,
     pub groups: Vec<groups::Group>,
     pub scene: Scene,
 }
@@ -429,21 +449,30 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
     pool.install(|| run_prepared(prepare(scene)?, opts, threads))
 }
 
-fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
-    let start = Instant::now();
+/// The simulation of a prepared scene, at rest, taking over the model's arrays (no copy);
+/// with `[concrete]`, the damage and plasticity kernel is on.
+pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
     let integration = Integration {
         dt: p.dt,
         lagged_forces: p.model.scene.solver.force_lag == crate::scene::ForceLag::Previous,
         ramp: p.model.scene.loading.ramp,
         t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
     };
-    // the simulation takes the model's arrays over rather than copying them
     let mut sim = Simulation::new(
         p.model.particles.x0.clone(),
         std::mem::take(&mut p.model.mech),
         std::mem::take(&mut p.model.prescribed),
         integration,
     );
+    if let Some(law) = p.model.scene.concrete_law() {
+        sim.inelastic = Some(Box::new(Concrete::new(law, &p.model.particles)));
+    }
+    sim
+}
+
+fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
+    let start = Instant::now();
+    let mut sim = build_simulation(&mut p);
     let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
     let bar = if opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7 {
         let b = indicatif::ProgressBar::new(p.steps as u64);
@@ -494,13 +523,23 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
         .zip(&p.model.particles.x0)
         .map(|(a, b)| a - b)
         .collect();
-    let stress = particle_stress(&sim.mech, &p.model.particles.volume, &x);
+    let (stress, damage) = match &sim.inelastic {
+        Some(model) => (
+            concrete::particle_stress(&sim.mech, model.concrete(), &x),
+            Some(model.concrete().committed.clone()),
+        ),
+        None => (
+            particle_stress(&sim.mech, &p.model.particles.volume, &x),
+            None,
+        ),
+    };
     let summary = summarise(
         &p,
         &records,
         wall,
         threads,
         failure.as_ref().map(|e| e.to_string()),
+        damage.as_deref(),
     );
     let outcome = Outcome {
         summary,
@@ -508,6 +547,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
         x0: p.model.particles.x0.clone(),
         displacement,
         stress,
+        damage,
         groups: p.model.groups.clone(),
         scene: p.model.scene.clone(),
     };
@@ -520,6 +560,7 @@ fn summarise(
     wall: f64,
     threads: usize,
     failure: Option<String>,
+    damage: Option<&[ParticleDamage]>,
 ) -> Summary {
     let sign = p
         .probe
@@ -533,11 +574,27 @@ fn summarise(
     });
     let last = records.last().copied().unwrap_or_default();
     let umax = records.iter().map(|r| r.internal_j).fold(0.0, f64::max);
-    let ratio = records
-        .iter()
-        .filter(|r| r.internal_j >= 0.01 * umax && umax > 0.0)
-        .map(|r| r.kinetic_j / r.internal_j)
-        .fold(0.0, f64::max);
+    let ratio_over = |rs: &[Record]| {
+        rs.iter()
+            .filter(|r| r.internal_j >= 0.01 * umax && umax > 0.0)
+            .map(|r| r.kinetic_j / r.internal_j)
+            .fold(0.0, f64::max)
+    };
+    // Before and around the peak: the records up to the peak and after it while the force
+    // stays at 80% of the peak or more.
+    let window_end = match peak {
+        Some(pk) => {
+            let ipk = records.iter().position(|r| r.step == pk.step).unwrap_or(0);
+            records[ipk..]
+                .iter()
+                .position(|r| sign * r.force_n < 0.8 * sign * pk.force_n)
+                .map(|o| ipk + o)
+                .unwrap_or(records.len())
+        }
+        None => records.len(),
+    };
+    let ratio = ratio_over(&records[..window_end]);
+    let ratio_whole = ratio_over(records);
     let d = &p.model.scene.discretisation;
     Summary {
         scene: p.model.scene.name().to_string(),
@@ -572,6 +629,14 @@ fn summarise(
         internal_energy_j: last.internal_j,
         kinetic_energy_j: last.kinetic_j,
         max_kinetic_to_internal_energy: ratio,
+        max_kinetic_to_internal_energy_whole_run: ratio_whole,
+        max_damage: damage.map(|d| d.iter().map(|p| p.wt).fold(0.0, f64::max)),
+        max_compressive_damage: damage.map(|d| d.iter().map(|p| p.wc).fold(0.0, f64::max)),
+        cracked_particles: damage.map(|d| d.iter().filter(|p| p.wt >= 0.99).count()),
+        crushed_particles: damage.map(|d| d.iter().filter(|p| p.wc >= 0.99).count()),
+        yielded_particles: damage.map(|d| d.iter().filter(|p| p.yielded).count()),
+        concrete: p.model.scene.concrete_law(),
+        material_values: p.model.scene.derived.clone(),
         force_lag: p.model.scene.solver.force_lag,
         surface_correction: p.model.surface.clone(),
         micro_modulus_a_bulk: p.model.bulk.a,

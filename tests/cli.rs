@@ -190,3 +190,56 @@ fn an_unstable_run_names_step_and_particle() {
     assert!(summary.contains("\"status\": \"unstable\""));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// A concrete scene writes the crack map and particles.csv, and its summary lists the damage
+/// figures and the material values with their sources. The shipped tension block, coarsened
+/// to L0 = 25 mm and shortened: the crack map is checked for existence, not for physics
+/// (tests/concrete.rs does that).
+#[test]
+fn concrete_run_writes_crack_map_and_damage_summary() {
+    let out = tmp("concrete");
+    let o = sppm(&[
+        "run",
+        "lattices/uniaxial_tension.toml",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "discretisation.spacing=0.025",
+        "--set",
+        "loading.end_periods=20",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["crack_map.svg", "particles.csv", "summary.json"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let svg = std::fs::read_to_string(out.join("crack_map.svg")).unwrap();
+    assert!(svg.contains("tensile damage"));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "dissipated_energy_J",
+        "max_damage",
+        "cracked_particles",
+        "max_kinetic_to_internal_energy",
+        "concrete",
+        "material_values",
+    ] {
+        assert!(s.get(key).is_some(), "summary.json lacks {key}");
+    }
+    assert_eq!(s["max_damage"], 1.0, "the block breaks");
+    let sources: Vec<String> = s["material_values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| format!("{}: {}", d["key"], d["source"]))
+        .collect();
+    assert!(
+        sources
+            .iter()
+            .any(|t| t.contains("\"E\"") && t.contains("ACI")),
+        "{sources:?}"
+    );
+    let csv = std::fs::read_to_string(out.join("particles.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().contains("tensile_damage"));
+}

@@ -65,6 +65,17 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
     };
     match sel {
         Selection::All => (0..p.len() as u32).collect(),
+        Selection::Nearest { point } => {
+            let q = Vector2::new(point[0], point[1]);
+            (0..p.len())
+                .min_by(|&a, &b| {
+                    (p.x0[a] - q)
+                        .norm_squared()
+                        .total_cmp(&(p.x0[b] - q).norm_squared())
+                })
+                .map(|i| vec![i as u32])
+                .unwrap_or_default()
+        }
         Selection::Box { min, max } => pick(&|x| {
             x.x >= min[0] - eps && x.x <= max[0] + eps && x.y >= min[1] - eps && x.y <= max[1] + eps
         }),

@@ -1,4 +1,8 @@
-//! The SPLM/SPPM constitutive model: micro-moduli, stretch, force state, stress.
+//! The SPLM/SPPM constitutive model: micro-moduli, stretch, force state, stress, strain,
+//! damage and plasticity.
+pub mod damage;
 pub mod micro_modulus;
+pub mod plasticity;
+pub mod strain;
 pub mod stress;
 pub mod stretch;

@@ -35,3 +35,35 @@ pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
     w.flush()?;
     Ok(())
 }
+
+/// particles.csv: one row per particle at the end of the run: reference position, displacement,
+/// stress (3.18) and, with damage, w_t, w_c and whether it yielded.
+pub fn write_particles(o: &crate::run::Outcome, path: &Path) -> anyhow::Result<()> {
+    let mut w = ::csv::Writer::from_path(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    let mut head = vec!["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];
+    if o.damage.is_some() {
+        head.extend(["tensile_damage", "compressive_damage", "yielded"]);
+    }
+    w.write_record(&head)?;
+    for i in 0..o.x0.len() {
+        let (x, u, s) = (o.x0[i], o.displacement[i], o.stress[i]);
+        let mut row = vec![
+            format!("{:e}", x.x),
+            format!("{:e}", x.y),
+            format!("{:e}", u.x),
+            format!("{:e}", u.y),
+            format!("{:e}", s[(0, 0)]),
+            format!("{:e}", s[(1, 1)]),
+            format!("{:e}", s[(0, 1)]),
+        ];
+        if let Some(d) = &o.damage {
+            row.push(format!("{}", d[i].wt));
+            row.push(format!("{}", d[i].wc));
+            row.push(format!("{}", d[i].yielded as u8));
+        }
+        w.write_record(&row)?;
+    }
+    w.flush()?;
+    Ok(())
+}

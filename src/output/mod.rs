@@ -1,5 +1,5 @@
-//! Reports of a run (ARCHITECTURE.md, "Interfaces"): summary.json, force_displacement.csv,
-//! force_displacement.svg, particle_map.svg and particles.vtk in the run's folder.
+//! Reports of a run (ARCHITECTURE.md, "Interfaces"): summary.json, force_displacement.csv, particles.csv,
+//! force_displacement.svg, crack_map.svg (scenes with damage), particle_map.svg and particles.vtk in the run's folder.
 
 pub mod csv;
 pub mod fields;
@@ -25,10 +25,18 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
     let f = dir.join("force_displacement.csv");
     csv::write_records(&outcome.records, &f)?;
     files.push(f);
+    let f = dir.join("particles.csv");
+    csv::write_particles(outcome, &f)?;
+    files.push(f);
     let f = dir.join("force_displacement.svg");
     plots::force_displacement(outcome, &f)?;
     files.push(f);
     let o = &outcome.scene.output;
+    if outcome.damage.is_some() {
+        let f = dir.join("crack_map.svg");
+        plots::crack_map(outcome, o.crack_map_scale, &f)?;
+        files.push(f);
+    }
     if o.map {
         let f = dir.join("particle_map.svg");
         plots::particle_map(outcome, o.field, o.deformed_scale, &f)?;

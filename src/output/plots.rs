@@ -34,12 +34,19 @@ pub fn viridis(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
-/// force_displacement.svg: reaction of the probe group (kN) against its displacement (mm).
+/// force_displacement.svg: reaction of the probe group (kN) against its displacement (mm);
+/// a group pushed in the negative direction (compression) is plotted with both signs turned,
+/// so that the curve rises from the origin either way.
 pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
+    let sign = if o.records.iter().any(|r| r.displacement_m < 0.0) {
+        -1.0
+    } else {
+        1.0
+    };
     let pts: Vec<(f64, f64)> = o
         .records
         .iter()
-        .map(|r| (r.displacement_m * 1e3, r.force_n * 1e-3))
+        .map(|r| (sign * r.displacement_m * 1e3, sign * r.force_n * 1e-3))
         .collect();
     let (mut x0, mut x1, mut y0, mut y1) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for &(x, y) in &pts {
@@ -67,26 +74,22 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
         .y_label_area_size(70)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
+    let turned = if sign < 0.0 { " (sign turned)" } else { "" };
     chart
         .configure_mesh()
-        .x_desc(format!("displacement of group '{group}' (mm)"))
-        .y_desc("reaction force (kN)")
+        .x_desc(format!("displacement of group '{group}' (mm){turned}"))
+        .y_desc(format!("reaction force (kN){turned}"))
         .draw()
         .map_err(err)?;
     chart
         .draw_series(LineSeries::new(pts.iter().copied(), BLUE.stroke_width(2)))
         .map_err(err)?;
     if o.summary.peak_force_n != 0.0 {
-        let sign = if o.records.iter().any(|r| r.displacement_m < 0.0) {
-            -1.0
-        } else {
-            1.0
-        };
         chart
             .draw_series(std::iter::once(Circle::new(
                 (
-                    o.summary.displacement_at_peak_m * 1e3,
-                    sign * o.summary.peak_force_n * 1e-3,
+                    sign * o.summary.displacement_at_peak_m * 1e3,
+                    o.summary.peak_force_n * 1e-3,
                 ),
                 5,
                 RED.filled(),
@@ -105,9 +108,12 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// particle_map.svg: every particle as a disc coloured by `field`, at x0 + scale·u.
-pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyhow::Result<()> {
-    let values = fields::values(o, field);
+/// Bounds (x0, x1, y0, y1) of a drawing, in mm.
+type Bounds = (f64, f64, f64, f64);
+
+/// Particle positions x0 + scale·u in mm, and the drawing's bounds with a margin of one
+/// spacing.
+fn particle_positions_mm(o: &Outcome, scale: f64) -> (Vec<(f64, f64)>, Bounds) {
     let pos: Vec<(f64, f64)> =
         o.x0.iter()
             .zip(&o.displacement)
@@ -126,7 +132,14 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
         y1 = y1.max(y);
     }
     let l0 = o.summary.spacing_m * 1e3;
-    let (x0, x1, y0, y1) = (x0 - l0, x1 + l0, y0 - l0, y1 + l0);
+    (pos, (x0 - l0, x1 + l0, y0 - l0, y1 + l0))
+}
+
+/// particle_map.svg: every particle as a disc coloured by `field`, at x0 + scale·u.
+pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyhow::Result<()> {
+    let values = fields::values(o, field);
+    let (pos, (x0, x1, y0, y1)) = particle_positions_mm(o, scale);
+    let l0 = o.summary.spacing_m * 1e3;
     // colour range: 1st to 99th percentile, so that a few boundary particles (whose
     // one-sided bond sums give low particle stresses) do not wash out the interior
     let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
@@ -204,6 +217,85 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
         )
     }))
     .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Colour of a tensile damage value: light grey (intact) to dark red (w_t = 1).
+fn damage_colour(w: f64) -> RGBColor {
+    let w = w.clamp(0.0, 1.0);
+    let lerp = |a: f64, b: f64| (a + (b - a) * w).round() as u8;
+    RGBColor(lerp(225.0, 150.0), lerp(225.0, 0.0), lerp(225.0, 0.0))
+}
+
+/// crack_map.svg: particles coloured by tensile damage w_t (grey intact → dark red fully
+/// cracked), particles with compressive damage w_c ≥ 0.5 that are not cracked marked with a
+/// black ×, particles that yielded with a blue ring; at x0 + scale·u.
+pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
+    let Some(damage) = &o.damage else {
+        return Ok(());
+    };
+    let (pos, (x0, x1, y0, y1)) = particle_positions_mm(o, scale);
+    let l0 = o.summary.spacing_m * 1e3;
+    let plot_w = 700.0;
+    let plot_h = (plot_w * (y1 - y0) / (x1 - x0)).clamp(150.0, 1400.0);
+    let width = plot_w as u32 + 90;
+    let height = plot_h as u32 + 130;
+    let root = SVGBackend::new(path, (width, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let cracked = damage.iter().filter(|p| p.wt >= 0.99).count();
+    let crushed = damage.iter().filter(|p| p.wc >= 0.5 && p.wt < 0.99).count();
+    let yielded = damage.iter().filter(|p| p.yielded).count();
+    let title = format!(
+        "{}: tensile damage{}",
+        o.summary.scene,
+        if scale > 0.0 {
+            format!(" (deformed ×{scale})")
+        } else {
+            String::new()
+        }
+    );
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(60)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(format!(
+            "x (mm)   —   red: w_t (grey 0 → dark red 1; {cracked} with w_t ≥ 0.99)   ×: w_c ≥ 0.5 ({crushed})   blue ring: yielded ({yielded})"
+        ))
+        .y_desc("y (mm)")
+        .draw()
+        .map_err(err)?;
+    let px_per_mm = plot_w / (x1 - x0);
+    let radius = ((0.5 * l0 * px_per_mm).round() as i32).max(1);
+    chart
+        .draw_series(
+            pos.iter()
+                .zip(damage)
+                .map(|(&p, d)| Circle::new(p, radius, damage_colour(d.wt).filled())),
+        )
+        .map_err(err)?;
+    chart
+        .draw_series(
+            pos.iter()
+                .zip(damage)
+                .filter(|(_, d)| d.yielded)
+                .map(|(&p, _)| Circle::new(p, (radius - 1).max(1), BLUE.stroke_width(1))),
+        )
+        .map_err(err)?;
+    chart
+        .draw_series(
+            pos.iter()
+                .zip(damage)
+                .filter(|(_, d)| d.wc >= 0.5 && d.wt < 0.99)
+                .map(|(&p, _)| Cross::new(p, (radius - 1).max(2), BLACK.stroke_width(1))),
+        )
+        .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
 }

@@ -67,6 +67,20 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
             be(&mut w, v)?;
         }
     }
+    if let Some(d) = &o.damage {
+        type Get = fn(&crate::solver::concrete::ParticleDamage) -> f64;
+        let scalars: [(&str, Get); 3] = [
+            ("tensile_damage", |p| p.wt),
+            ("compressive_damage", |p| p.wc),
+            ("yielded", |p| if p.yielded { 1.0 } else { 0.0 }),
+        ];
+        for (name, get) in scalars {
+            writeln!(w, "\nSCALARS {name} float 1\nLOOKUP_TABLE default")?;
+            for p in d {
+                be(&mut w, get(p))?;
+            }
+        }
+    }
     for g in &o.groups {
         let mut member = vec![0.0; n];
         for &i in &g.members {

@@ -4,11 +4,13 @@
 //! message that names the key, the value and what is allowed.
 
 mod overrides;
+mod resolve;
 mod validate;
 
 pub use overrides::apply_overrides;
 pub use validate::SceneError;
 
+use crate::material::concrete::{Derived, Preset};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -25,6 +27,9 @@ pub struct Scene {
     pub body: BodySpec,
     pub discretisation: DiscretisationSpec,
     pub material: MaterialSpec,
+    /// Concrete damage and plasticity (MODEL.md §6–9, §11); its presence turns them on.
+    #[serde(default)]
+    pub concrete: Option<ConcreteSpec>,
     #[serde(default)]
     pub groups: Vec<GroupSpec>,
     #[serde(default)]
@@ -35,6 +40,10 @@ pub struct Scene {
     pub solver: SolverSpec,
     #[serde(default)]
     pub output: OutputSpec,
+    /// Every material value the run uses and where it came from (scene, preset or
+    /// correlation), filled by [`Scene::resolve`]; not read from the file.
+    #[serde(skip_deserializing)]
+    pub derived: Vec<Derived>,
 }
 
 /// The specimen's shape (`[body] shape = "..."`). Lengths in metres.
@@ -109,9 +118,10 @@ pub enum Plane {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
-    /// Young's modulus E (Pa).
-    #[serde(rename = "E")]
-    pub e: f64,
+    /// Young's modulus E (Pa). May be left out when a `[concrete]` section is given: it then
+    /// follows from f'c and ρ by ACI 318-14 (5.2). Always set after [`Scene::resolve`].
+    #[serde(rename = "E", default)]
+    pub e: Option<f64>,
     /// Poisson's ratio ν.
     pub nu: f64,
     /// Density ρ (kg/m³).
@@ -120,6 +130,123 @@ pub struct MaterialSpec {
     pub thickness: f64,
     #[serde(default = "default_plane")]
     pub plane: Plane,
+}
+
+impl MaterialSpec {
+    /// Young's modulus (Pa) after [`Scene::resolve`].
+    pub fn youngs_modulus(&self) -> f64 {
+        self.e.unwrap_or(f64::NAN)
+    }
+}
+
+/// How tensile damage starts (MODEL.md §8).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Initiation {
+    /// σ_PI ≥ f't.
+    Rankine,
+    /// σ_PI/f't − min(σ_PIII, 0)/f'c ≥ 1.
+    Interaction,
+}
+
+/// Which crack opening drives the softening law (MODEL.md §8).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CrackOpening {
+    /// COD_eq = 2·L0·ε_I as written in (4.13) (w_t jumps at initiation).
+    Total,
+    /// COD_eq measured from initiation: 2·L0·(ε_I − ε_I at initiation).
+    Inelastic,
+}
+
+/// Concrete (MODEL.md §6–9, §11). Strengths in Pa, G_f in N/m (J/m²), lengths in m. A value
+/// left out comes from the preset, else from the correlation of §11, else the default shown.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConcreteSpec {
+    /// A concrete of the source (see [`Preset`]); fills f'c, d_max and, for the dog-bones, f't.
+    #[serde(default)]
+    pub preset: Option<Preset>,
+    /// Compressive strength f'c (Pa).
+    #[serde(default)]
+    pub fc: Option<f64>,
+    /// Tensile strength f't (Pa); default ACI 318-92, 6·√f'c psi (5.1).
+    #[serde(default)]
+    pub ft: Option<f64>,
+    /// Yield strength f_y (Pa); default (5/6)·f'c.
+    #[serde(default)]
+    pub fy: Option<f64>,
+    /// Ultimate strength f_ult (Pa) reached at ε_ult; default f'c.
+    #[serde(default)]
+    pub fult: Option<f64>,
+    /// Fracture energy G_f (N/m); default CEB-FIP 1990 (5.3) from G_f0 and f'c.
+    #[serde(rename = "Gf", default)]
+    pub gf: Option<f64>,
+    /// Base fracture energy G_f0 (N/m); default from the maximum aggregate size.
+    #[serde(rename = "Gf0", default)]
+    pub gf0: Option<f64>,
+    /// Maximum aggregate size d_max (m): 0.008, 0.016, 0.019 or 0.032.
+    #[serde(default)]
+    pub max_aggregate: Option<f64>,
+    /// Ultimate strain ε_ult: w_c = 1 beyond it (4.17); default 0.0035.
+    #[serde(default = "default_eps_ult")]
+    pub eps_ult: f64,
+    /// Knee of the bilinear softening law at COD_1 = α·COD_c; default 0.1.
+    #[serde(default = "default_alpha")]
+    pub alpha: f64,
+    /// Stress at the knee γ·f't; default 0.25.
+    #[serde(default = "default_gamma")]
+    pub gamma: f64,
+    /// w_t above which compressive damage starts (4.16); default 1/3.
+    #[serde(default = "default_wt_cr")]
+    pub wt_cr: f64,
+    /// Largest compressive damage from (4.16); default 1.
+    #[serde(default = "default_wc_max")]
+    pub wc_max: f64,
+    /// The crack-band length of (4.13) in units of L0: COD_eq = crack_band·L0·ε_I. (4.13)
+    /// writes 2; the default 2.8 is measured: with 2, a block in uniaxial tension dissipates
+    /// 1.32 and 1.47 × G_f·A at L0 = 10 and 5 mm; with 2.8, 0.975 and 1.029 × G_f·A
+    /// (benchmarks/RESULTS.md, "Concrete in 2D").
+    #[serde(default = "default_crack_band")]
+    pub crack_band: f64,
+    #[serde(default = "default_initiation")]
+    pub initiation: Initiation,
+    #[serde(default = "default_crack_opening")]
+    pub crack_opening: CrackOpening,
+    /// Tensile damage (4.12–4.14); default on (off isolates plasticity, e.g. in tests).
+    #[serde(default = "default_true")]
+    pub tensile_damage: bool,
+    /// Compressive damage (4.16, 4.17); default on.
+    #[serde(default = "default_true")]
+    pub compressive_damage: bool,
+    /// Plasticity with hardening (3.38–3.48, 4.15); default on.
+    #[serde(default = "default_true")]
+    pub plasticity: bool,
+}
+
+fn default_eps_ult() -> f64 {
+    0.0035
+}
+fn default_alpha() -> f64 {
+    0.1
+}
+fn default_gamma() -> f64 {
+    0.25
+}
+fn default_wt_cr() -> f64 {
+    1.0 / 3.0
+}
+fn default_wc_max() -> f64 {
+    1.0
+}
+fn default_crack_band() -> f64 {
+    2.8
+}
+fn default_initiation() -> Initiation {
+    Initiation::Rankine
+}
+fn default_crack_opening() -> CrackOpening {
+    CrackOpening::Total
 }
 
 fn default_plane() -> Plane {
@@ -186,6 +313,9 @@ pub enum Selection {
     },
     /// Particles inside an axis-aligned box.
     Box { min: [f64; 2], max: [f64; 2] },
+    /// The one particle nearest a point (for a point support that must exist at every
+    /// lattice rotation and offset).
+    Nearest { point: [f64; 2] },
     /// Every particle.
     All,
 }
@@ -196,8 +326,18 @@ pub enum Selection {
 pub struct LoadSpec {
     /// Loaded component: "x" or "y".
     pub component: Axis,
-    /// Δmax (m): the displacement at the end of the ramp (signed).
-    pub displacement: f64,
+    /// Δmax (m): the displacement at the end of the ramp (signed). May be left out in a
+    /// scene with `[concrete]`: it then defaults to +1.5·COD_c (tension, MODEL.md §10).
+    /// Always set after [`Scene::resolve`].
+    #[serde(default)]
+    pub displacement: Option<f64>,
+}
+
+impl LoadSpec {
+    /// Δmax (m) after [`Scene::resolve`].
+    pub fn delta(&self) -> f64 {
+        self.displacement.unwrap_or(f64::NAN)
+    }
 }
 
 /// Time history of the displacement loading (MODEL.md §10).
@@ -349,6 +489,11 @@ pub struct OutputSpec {
     /// Magnification of displacements in the particle map (0: reference shape).
     #[serde(default)]
     pub deformed_scale: f64,
+    /// Magnification of displacements in the crack map (default 0: the reference shape, where
+    /// a crack shows as a band of red particles; fully cracked particles move freely and
+    /// scatter in a magnified view).
+    #[serde(default)]
+    pub crack_map_scale: f64,
     /// Write the particle map SVG.
     #[serde(default = "default_true")]
     pub map: bool,
@@ -364,6 +509,7 @@ impl Default for OutputSpec {
             probe_group: None,
             field: default_field(),
             deformed_scale: 0.0,
+            crack_map_scale: 0.0,
             map: true,
             vtk: true,
         }
@@ -384,8 +530,9 @@ impl Scene {
             .parse()
             .map_err(|e: toml::de::Error| SceneError::Parse(e.to_string()))?;
         apply_overrides(&mut value, overrides)?;
-        let scene: Scene = Scene::deserialize(toml::Value::Table(value))
+        let mut scene: Scene = Scene::deserialize(toml::Value::Table(value))
             .map_err(|e| SceneError::Parse(e.to_string()))?;
+        scene.resolve()?;
         scene.validate()?;
         Ok(scene)
     }

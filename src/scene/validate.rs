@@ -103,7 +103,7 @@ impl Scene {
         }
 
         let m = &self.material;
-        positive("material.E", m.e)?;
+        positive("material.E", m.youngs_modulus())?;
         positive("material.rho", m.rho)?;
         positive("material.thickness", m.thickness)?;
         if !(m.nu.is_finite() && m.nu > -1.0 && m.nu < 0.5) {
@@ -164,6 +164,10 @@ impl Scene {
                         }
                     }
                 }
+                Selection::Nearest { point } => {
+                    finite(&format!("{key}.select.point[0]"), point[0])?;
+                    finite(&format!("{key}.select.point[1]"), point[1])?;
+                }
                 Selection::All => {}
             }
             let mut fixed = HashSet::new();
@@ -178,7 +182,7 @@ impl Scene {
             }
             if let Some(l) = &g.load {
                 any_load = true;
-                finite(&format!("{key}.load.displacement"), l.displacement)?;
+                finite(&format!("{key}.load.displacement"), l.delta())?;
                 if fixed.contains(&l.component.index()) {
                     return Err(invalid(
                         format!("{key}.load.component"),
@@ -281,12 +285,17 @@ impl Scene {
                 _ => {}
             }
         }
-        if !(o.deformed_scale.is_finite() && o.deformed_scale >= 0.0) {
-            return Err(invalid(
-                "output.deformed_scale",
-                o.deformed_scale,
-                "a magnification >= 0 (0 draws the reference shape)",
-            ));
+        for (key, v) in [
+            ("output.deformed_scale", o.deformed_scale),
+            ("output.crack_map_scale", o.crack_map_scale),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(invalid(
+                    key,
+                    v,
+                    "a magnification >= 0 (0 draws the reference shape)",
+                ));
+            }
         }
         Ok(())
     }

@@ -1,6 +1,7 @@
 //! Time integration of a discretised specimen: the step kernel, displacement loading,
 //! probes (reaction force, energies) and the stability guard (ARCHITECTURE.md, "Solver").
 
+pub mod concrete;
 pub mod kernel;
 pub mod lanczos;
 pub mod linear;
@@ -74,6 +75,8 @@ pub struct Simulation<const D: usize, const K: usize> {
     energy_scale: f64,
     /// Whether the kernel with bond dampers runs (decided once, before the loop).
     bond_dampers: bool,
+    /// Damage and plasticity; `None` runs the elastic kernel.
+    pub inelastic: Option<Box<dyn concrete::Inelastic<D, K>>>,
 }
 
 impl<const D: usize, const K: usize> Simulation<D, K> {
@@ -95,6 +98,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             external_work: 0.0,
             energy_scale: 0.0,
             bond_dampers,
+            inelastic: None,
         }
     }
 
@@ -120,12 +124,32 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     /// Advance one step. Returns the probe record when `record` is given.
     pub fn advance(&mut self, record: Option<&Probe>) -> Option<Record> {
         let dt = self.integration.dt;
+        if let Some(model) = self.inelastic.as_mut() {
+            model.step(
+                &self.mech,
+                &mut self.state,
+                dt,
+                self.integration.lagged_forces,
+                self.bond_dampers,
+            );
+        } else {
+            self.step_elastic(dt);
+        }
+        self.finish_step(record)
+    }
+
+    fn step_elastic(&mut self, dt: f64) {
         match (self.integration.lagged_forces, self.bond_dampers) {
             (false, false) => kernel::step::<D, K, false, false>(&self.mech, &mut self.state, dt),
             (false, true) => kernel::step::<D, K, false, true>(&self.mech, &mut self.state, dt),
             (true, false) => kernel::step::<D, K, true, false>(&self.mech, &mut self.state, dt),
             (true, true) => kernel::step::<D, K, true, true>(&self.mech, &mut self.state, dt),
         }
+    }
+
+    /// Supports, loading, probes and the swap to the next step, after the kernel.
+    fn finish_step(&mut self, record: Option<&Probe>) -> Option<Record> {
+        let dt = self.integration.dt;
         let t = self.time();
         // The ramp at n−1, n and n+1, once for every prescribed component.
         let r_prev = if self.step == 0 {
@@ -215,6 +239,9 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     /// Elastic energy stored in the bonds at the current positions,
     /// U = ¼·Σ_i Σ_j L0,ij·S_ij·F_s,ij (so that ∂U/∂L_ij = F_b,ij; see MODEL.md §7).
     pub fn internal_energy_now(&self) -> f64 {
+        if let Some(model) = &self.inelastic {
+            return model.internal_energy(&self.mech, &self.state.x);
+        }
         let x = &self.state.x;
         let m = &self.mech;
         (0..x.len())

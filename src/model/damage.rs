@@ -1,0 +1,220 @@
+//! Two-spring damage (MODEL.md §6, (3.36), (3.37)) and the concrete laws that drive it:
+//! tensile initiation and bilinear softening (§8, (4.12)–(4.14)), compressive damage
+//! (§9, (4.16), (4.17)).
+
+use crate::scene::{CrackOpening, Initiation, Plane};
+
+/// The resolved concrete law of a run (every value in SI; see `Scene::concrete_law`).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct ConcreteLaw {
+    pub e: f64,
+    pub nu: f64,
+    pub plane: Plane,
+    pub fc: f64,
+    pub ft: f64,
+    pub fy: f64,
+    pub fult: f64,
+    pub gf: f64,
+    /// COD_c (5.4).
+    pub cod_c: f64,
+    /// COD_1 = α·COD_c, the knee.
+    pub cod_1: f64,
+    pub gamma: f64,
+    pub eps_ult: f64,
+    pub wt_cr: f64,
+    pub wc_max: f64,
+    pub initiation: Initiation,
+    pub crack_opening: CrackOpening,
+    pub tensile_damage: bool,
+    pub compressive_damage: bool,
+    pub plasticity: bool,
+    /// The length that turns the largest principal strain into a crack opening,
+    /// COD_eq = crack_band·ε_I: 2·L0 (4.13).
+    pub crack_band: f64,
+}
+
+/// Damage factor of a bond whose two particles have damage w_i and w_j (3.37): the two
+/// springs in series, d = 2(1−w_i)(1−w_j)/(2−w_i−w_j); 0 when either is fully damaged
+/// (including the 0/0 case w_i = w_j = 1). Symmetric bit for bit in (w_i, w_j), so that
+/// F_b,ij and F_b,ji cancel exactly.
+#[inline(always)]
+pub fn damage_factor(wi: f64, wj: f64) -> f64 {
+    if wi >= 1.0 || wj >= 1.0 {
+        return 0.0;
+    }
+    2.0 * ((1.0 - wi) * (1.0 - wj)) / (2.0 - (wi + wj))
+}
+
+/// Bilinear stress–crack-opening law (Hillerborg; Fig. 4.4): f't at COD = 0, γ·f't at
+/// COD_1, zero at COD_c and beyond.
+#[inline]
+pub fn softening_stress(law: &ConcreteLaw, cod: f64) -> f64 {
+    if cod <= 0.0 {
+        law.ft
+    } else if cod < law.cod_1 {
+        law.ft * (law.cod_1 + (law.gamma - 1.0) * cod) / law.cod_1
+    } else if cod < law.cod_c {
+        law.gamma * law.ft * (law.cod_c - cod) / (law.cod_c - law.cod_1)
+    } else {
+        0.0
+    }
+}
+
+/// Whether tensile damage starts (MODEL.md §8) for principal stresses p1 ≥ p2 ≥ p3
+/// (σ_PI = max(p1, 0) (4.12), σ_PIII = p3).
+#[inline]
+pub fn initiates(law: &ConcreteLaw, p1: f64, p3: f64) -> bool {
+    let s1 = p1.max(0.0);
+    match law.initiation {
+        Initiation::Rankine => s1 >= law.ft,
+        Initiation::Interaction => s1 / law.ft - p3.min(0.0) / law.fc >= 1.0,
+    }
+}
+
+/// Tensile damage (4.14) of an initiated particle with largest principal strain ε_I, so that
+/// (1−w_t)·E·ε_I follows the softening law at COD_eq = crack_band·ε_I (4.13), or, with
+/// [`CrackOpening::Inelastic`], at crack_band·(ε_I − ε_I,0) with ε_I,0 the strain at
+/// initiation. Returns 0 where ε_I ≤ 0 (the caller keeps the larger of old and new).
+#[inline]
+pub fn tensile_damage(law: &ConcreteLaw, eps_i: f64, eps_at_initiation: f64) -> f64 {
+    if eps_i <= 0.0 {
+        return 0.0;
+    }
+    let cod = match law.crack_opening {
+        CrackOpening::Total => law.crack_band * eps_i,
+        CrackOpening::Inelastic => law.crack_band * (eps_i - eps_at_initiation),
+    };
+    if cod >= law.cod_c {
+        return 1.0;
+    }
+    let w = 1.0 - softening_stress(law, cod) / (law.e * eps_i);
+    w.clamp(0.0, 1.0)
+}
+
+/// Compressive damage (4.16) from the tensile damage, and 1 once ε_eff > ε_ult (4.17).
+#[inline]
+pub fn compressive_damage(law: &ConcreteLaw, wt: f64, eps_eff: f64) -> f64 {
+    if eps_eff > law.eps_ult {
+        return 1.0;
+    }
+    if wt > law.wt_cr {
+        let r = law.wt_cr.sqrt();
+        (law.wc_max * (wt.sqrt() - r) / (1.0 - r)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// Effective strain (4.17) from the principal strains.
+#[inline]
+pub fn effective_strain(e1: f64, e2: f64, e3: f64) -> f64 {
+    (0.5 * ((e1 - e2).powi(2) + (e2 - e3).powi(2) + (e3 - e1).powi(2))).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn law(opening: CrackOpening) -> ConcreteLaw {
+        let (ft, gf, alpha, gamma) = (3.0e6, 100.0, 0.1, 0.25);
+        let cod_c = 2.0 * gf / (ft * (alpha + gamma));
+        ConcreteLaw {
+            e: 30e9,
+            nu: 0.2,
+            plane: Plane::Stress,
+            fc: 40e6,
+            ft,
+            fy: 40e6 * 5.0 / 6.0,
+            fult: 40e6,
+            gf,
+            cod_c,
+            cod_1: alpha * cod_c,
+            gamma,
+            eps_ult: 0.0035,
+            wt_cr: 1.0 / 3.0,
+            wc_max: 1.0,
+            initiation: Initiation::Rankine,
+            crack_opening: opening,
+            tensile_damage: true,
+            compressive_damage: true,
+            plasticity: true,
+            crack_band: 0.01,
+        }
+    }
+
+    #[test]
+    fn damage_factor_is_two_springs_in_series() {
+        assert_eq!(damage_factor(0.0, 0.0), 1.0);
+        // one spring at half stiffness, the other intact: series stiffness 2·(½·1)/(½+1) = 2/3
+        assert!((damage_factor(0.5, 0.0) - 2.0 / 3.0).abs() < 1e-15);
+        assert_eq!(damage_factor(1.0, 0.3), 0.0);
+        assert_eq!(damage_factor(1.0, 1.0), 0.0);
+        for (a, b) in [(0.1, 0.7), (0.33, 0.999), (0.25, 0.5)] {
+            assert_eq!(damage_factor(a, b).to_bits(), damage_factor(b, a).to_bits());
+        }
+    }
+
+    #[test]
+    fn bilinear_law_has_area_gf() {
+        let l = law(CrackOpening::Inelastic);
+        let n = 200_000;
+        let h = l.cod_c / n as f64;
+        let area: f64 = (0..n)
+            .map(|k| softening_stress(&l, (k as f64 + 0.5) * h) * h)
+            .sum();
+        assert!((area / l.gf - 1.0).abs() < 1e-6, "{}", area / l.gf);
+        assert!((softening_stress(&l, l.cod_1) - l.gamma * l.ft).abs() < 1e-6);
+    }
+
+    #[test]
+    fn tensile_damage_follows_the_softening_curve() {
+        for opening in [CrackOpening::Total, CrackOpening::Inelastic] {
+            let l = law(opening);
+            let e0 = l.ft / l.e;
+            for f in [1.0, 1.5, 3.0, 10.0, 30.0] {
+                let eps = f * e0;
+                let w = tensile_damage(&l, eps, e0);
+                let cod = match opening {
+                    CrackOpening::Total => l.crack_band * eps,
+                    CrackOpening::Inelastic => l.crack_band * (eps - e0),
+                };
+                let sigma = (1.0 - w) * l.e * eps;
+                assert!((sigma - softening_stress(&l, cod)).abs() < 1e-6 * l.ft);
+            }
+            // beyond COD_c the particle is fully damaged
+            assert_eq!(
+                tensile_damage(&l, 2.0 * l.cod_c / l.crack_band + e0, e0),
+                1.0
+            );
+        }
+        // As written, w_t jumps at initiation by (1−γ)·COD_el/COD_1 (the source says so).
+        let l = law(CrackOpening::Total);
+        let e0 = l.ft / l.e;
+        let jump = (1.0 - l.gamma) * l.crack_band * e0 / l.cod_1;
+        assert!((tensile_damage(&l, e0, e0) - jump).abs() < 1e-12);
+        assert_eq!(tensile_damage(&law(CrackOpening::Inelastic), e0, e0), 0.0);
+    }
+
+    #[test]
+    fn compressive_damage_law() {
+        let l = law(CrackOpening::Inelastic);
+        assert_eq!(compressive_damage(&l, 1.0 / 3.0, 0.0), 0.0);
+        assert!((compressive_damage(&l, 1.0, 0.0) - 1.0).abs() < 1e-15);
+        let w = 0.6f64;
+        let r = (1.0f64 / 3.0).sqrt();
+        assert!((compressive_damage(&l, w, 0.0) - (w.sqrt() - r) / (1.0 - r)).abs() < 1e-15);
+        assert_eq!(compressive_damage(&l, 0.0, 0.0036), 1.0);
+        assert!((effective_strain(1.0, 0.0, 0.0) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn initiation_criteria() {
+        let mut l = law(CrackOpening::Inelastic);
+        assert!(initiates(&l, l.ft, 0.0));
+        assert!(!initiates(&l, 0.99 * l.ft, -0.5 * l.fc));
+        l.initiation = Initiation::Interaction;
+        assert!(initiates(&l, 0.5 * l.ft, -0.5 * l.fc));
+        assert!(!initiates(&l, 0.0, -0.99 * l.fc));
+        assert!(initiates(&l, 0.0, -l.fc));
+    }
+}

@@ -1,0 +1,499 @@
+//! The step kernel with two-spring damage and plasticity (MODEL.md §2, §6–9), for 2D lattices.
+//!
+//! Same shape as the elastic kernel (`kernel.rs`): two gather passes, parallel over particles,
+//! no scatter and no allocation, so results do not depend on the thread count. State variables
+//! (w_t, w_c, the plastic stretch states) have a committed value, read by both passes of a
+//! step, and a trial value written by pass 1; [`Concrete::commit`] swaps them once per step
+//! (reading B of MODEL.md §4: elastic forces from the current positions, state variables from
+//! the previous step).
+//!
+//! 1. Each particle, from its slots: elastic stretch S_e = S_T − ½(S_Ps,ij + S_Ps,ji) (3.38),
+//!    damage factor d (3.37), bθ_i = b_i·Σ_m √d_im·S_e,im; then strain, criteria stress,
+//!    damage and plastic flow → trial state.
+//! 2. Each particle gathers F_b,ij = ½(d_ij·(a_i + a_j)·S_e,ij + √d_ij·(bθ_i + bθ_j)) along
+//!    e_ij, with the bond damper scaled by d_ij, and integrates.
+//!
+//! **Decision (erratum to (3.36)).** As written, F_s,ij = d_ij·a·S_e,ij + b·Σ_m d_im·S_e,im
+//! leaves the dilatation term on a bond whose particle is fully damaged: a broken particle i
+//! still feels ½·b_j·θ_j from each neighbour j, although the source states (its point 4
+//! after (3.37)) that the bond force then vanishes. Multiplying the whole force state by d_ij
+//! would fix that but scale the b-term by d² under uniform damage, so a uniformly damaged
+//! particle would not carry (1−w) of its elastic stress (measured: tension peaks 4–6% above
+//! f't·A). The kernel uses
+//!   F_s,ij = d_ij·a·S_e,ij + √d_ij·b·Σ_m √d_im·S_e,im,
+//! which (i) is (3.8) without damage, (ii) is exactly d·(3.8) when all bonds share one d
+//! (as (3.36) is), (iii) vanishes on a broken bond from both ends, and (iv) derives from the
+//! energy ¼·Σ_i[a·Σ_k L0·d_k·S_k² + b·(Σ_k √d_k·S_k)(Σ_k L0·√d_k·S_k)], so that the energy
+//! balance closes (tests/concrete.rs).
+//!
+//! **Decision (criteria stress).** Initiation (§8) and yield (§9) use σ_c = D·ε_d of the
+//! particle, ε_d the least-squares strain (see `model::strain`) of its damaged elastic
+//! stretches d_ij·S_e,ij, rather than (3.18). For an undamaged bulk particle the two are
+//! identical, and with damage they differ only by the d_ij on the b-term; but (3.18)
+//! under-reads at free surfaces (full ΔV, half the bonds) by up to ~60%, so cracks could
+//! neither start nor run through surface particles. The stress maps show (3.18).
+
+use super::mechanics::Mechanics;
+use crate::discretise::{Particles, NONE};
+use crate::model::damage::{self, ConcreteLaw};
+use crate::model::micro_modulus::elasticity_matrix;
+use crate::model::plasticity;
+use crate::model::strain::{self, StrainFit};
+use crate::model::stress::StressSum;
+use crate::model::stretch::total_stretch;
+use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+use rayon::prelude::*;
+
+/// The damage and plasticity state of one particle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ParticleDamage {
+    /// Tensile damage w_t.
+    pub wt: f64,
+    /// Compressive damage w_c.
+    pub wc: f64,
+    /// ε_I when tensile damage started.
+    pub eps_init: f64,
+    pub initiated: bool,
+    /// Has yielded at least once.
+    pub yielded: bool,
+}
+
+/// Damage and plasticity of a run: the law, the per-particle geometry the kernel needs, and
+/// the committed and trial state.
+#[derive(Clone, Debug)]
+pub struct Concrete<const K: usize> {
+    pub law: ConcreteLaw,
+    /// Elasticity matrix D of the law (Voigt, engineering shear).
+    pub d: Matrix3<f64>,
+    /// Least-squares strain projector of each particle (reference bond directions).
+    pub fit: Vec<StrainFit<K>>,
+    pub reverse: Vec<[u8; K]>,
+    pub l0: Vec<[f64; K]>,
+    pub volume: Vec<f64>,
+    /// Committed damage state (read by both passes of a step).
+    pub committed: Vec<ParticleDamage>,
+    trial: Vec<ParticleDamage>,
+    /// Committed plastic stretch states S_Ps,ij (3.48), per slot.
+    pub sps: Vec<[f64; K]>,
+    sps_trial: Vec<[f64; K]>,
+    /// Scratch from pass 1 for pass 2 of the same step.
+    cache: Vec<[SlotCache; K]>,
+}
+
+impl<const K: usize> Concrete<K> {
+    /// Undamaged, without plastic stretch.
+    pub fn new(law: ConcreteLaw, p: &Particles<2, K>) -> Self {
+        let n = p.len();
+        let fit = (0..n)
+            .map(|i| {
+                let mut dirs = [None; K];
+                for (k, d) in dirs.iter_mut().enumerate() {
+                    let j = p.neighbours[i][k];
+                    if j != NONE {
+                        *d = Some((p.x0[j as usize] - p.x0[i]).normalize());
+                    }
+                }
+                strain::strain_fit(&dirs)
+            })
+            .collect();
+        Concrete {
+            law,
+            d: elasticity_matrix(law.e, law.nu, law.plane),
+            fit,
+            reverse: p.reverse.clone(),
+            l0: p.l0.clone(),
+            volume: p.volume.clone(),
+            committed: vec![ParticleDamage::default(); n],
+            trial: vec![ParticleDamage::default(); n],
+            sps: vec![[0.0; K]; n],
+            sps_trial: vec![[0.0; K]; n],
+            cache: vec![[SlotCache::default(); K]; n],
+        }
+    }
+
+    /// Make the trial state the committed one (once per step, after pass 2).
+    pub fn commit(&mut self) {
+        std::mem::swap(&mut self.committed, &mut self.trial);
+        std::mem::swap(&mut self.sps, &mut self.sps_trial);
+    }
+}
+
+/// What pass 2 needs of one slot, left by pass 1 at the same positions and state: the unit
+/// vector, d·(a_i + a_j)·S_e, √d and d (0 everywhere in an empty slot).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SlotCache {
+    e: Vector2<f64>,
+    d_a_se: f64,
+    sd: f64,
+    d: f64,
+}
+
+/// One slot's kinematics: unit vector, total stretch, elastic stretch, damage factor.
+#[derive(Clone, Copy)]
+struct Slot {
+    e: Vector2<f64>,
+    st: f64,
+    se: f64,
+    d: f64,
+    /// √d.
+    sd: f64,
+}
+
+/// The slot of particle i in direction k, or `None` if empty. Computed identically from
+/// either end of the bond (S_T, S_P and d are symmetric bit for bit), so the two particles
+/// of a bond see the same elastic stretch and damage factor.
+#[inline(always)]
+fn slot<const K: usize>(
+    m: &Mechanics<2, K>,
+    c: &Concrete<K>,
+    x: &[Vector2<f64>],
+    i: usize,
+    k: usize,
+) -> Option<Slot> {
+    let j = m.neighbours[i][k];
+    if j == NONE {
+        return None;
+    }
+    let j = j as usize;
+    let dx = x[j] - x[i];
+    let len = dx.norm();
+    let st = total_stretch(len, m.inv_l0[i][k]);
+    let r = c.reverse[i][k] as usize;
+    let sp = 0.5 * (c.sps[i][k] + c.sps[j][r]);
+    let se = st - sp;
+    let (pi, pj) = (&c.committed[i], &c.committed[j]);
+    let (wi, wj) = if se >= 0.0 {
+        (pi.wt, pj.wt)
+    } else {
+        (pi.wc, pj.wc)
+    };
+    // The undamaged bond (most of them) skips the division and the square root.
+    let (d, sd) = if wi == 0.0 && wj == 0.0 {
+        (1.0, 1.0)
+    } else {
+        let d = damage::damage_factor(wi, wj);
+        (d, d.sqrt())
+    };
+    Some(Slot {
+        e: dx * (1.0 / len),
+        st,
+        se,
+        d,
+        sd,
+    })
+}
+
+/// All slots of particle i and its damaged dilatation term bθ_i = b_i·Σ_m √d_im·S_e,im.
+#[inline(always)]
+fn slots<const K: usize>(
+    m: &Mechanics<2, K>,
+    c: &Concrete<K>,
+    x: &[Vector2<f64>],
+    i: usize,
+) -> ([Option<Slot>; K], f64) {
+    let mut out = [None; K];
+    let mut theta = 0.0;
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = slot(m, c, x, i, k);
+        if let Some(s) = o {
+            theta += s.sd * s.se;
+        }
+    }
+    (out, m.b[i] * theta)
+}
+
+/// Pass 1 for particle i: bθ_i, and the trial damage and plastic stretch state.
+#[inline]
+fn update_state<const K: usize>(
+    m: &Mechanics<2, K>,
+    c: &Concrete<K>,
+    x: &[Vector2<f64>],
+    i: usize,
+    trial: &mut ParticleDamage,
+    sps_trial: &mut [f64; K],
+    cache: &mut [SlotCache; K],
+) -> f64 {
+    let (sl, b_theta) = slots(m, c, x, i);
+    for k in 0..K {
+        cache[k] = match sl[k] {
+            Some(s) => {
+                let j = m.neighbours[i][k] as usize;
+                SlotCache {
+                    e: s.e,
+                    d_a_se: s.d * ((m.a[i] + m.a[j]) * s.se),
+                    sd: s.sd,
+                    d: s.d,
+                }
+            }
+            None => SlotCache::default(),
+        };
+    }
+    let law = &c.law;
+    let mut p = c.committed[i];
+    *sps_trial = c.sps[i];
+    if p.wt >= 1.0 && p.wc >= 1.0 {
+        *trial = p;
+        return b_theta;
+    }
+    let mut st = [0.0; K];
+    let mut se = [0.0; K];
+    let mut dse = [0.0; K];
+    let mut used = [false; K];
+    let mut theta_e = 0.0;
+    for k in 0..K {
+        if let Some(s) = sl[k] {
+            st[k] = s.st;
+            se[k] = s.se;
+            dse[k] = s.d * s.se;
+            used[k] = true;
+            theta_e += s.se;
+        }
+    }
+    // Strains (§7): total for the damage law and ε_eff; the criteria stress from the damaged
+    // elastic stretches.
+    let eps = strain::strain_tensor(&c.fit[i], &st);
+    let (e1, e2, e3) = strain::principal_strains(&eps, law.nu, law.plane);
+    let eps_eff = damage::effective_strain(e1, e2, e3);
+    let eps_d = strain::strain_tensor(&c.fit[i], &dse);
+    let sv = c.d * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
+    let sigma = Matrix2::new(sv[0], sv[2], sv[2], sv[1]);
+
+    // Tensile damage (§8).
+    if law.tensile_damage && !p.initiated {
+        let (s1, s2) = strain::principal_values(&sigma);
+        let s33 = match law.plane {
+            crate::scene::Plane::Stress => 0.0,
+            crate::scene::Plane::Strain => law.nu * (s1 + s2),
+        };
+        let p1 = s1.max(s33);
+        let p3 = s2.min(s33);
+        if damage::initiates(law, p1, p3) {
+            p.initiated = true;
+            p.eps_init = e1;
+        }
+    }
+    if p.initiated {
+        p.wt = p.wt.max(damage::tensile_damage(law, e1, p.eps_init));
+    }
+    // Compressive damage (§9).
+    if law.compressive_damage {
+        p.wc = p.wc.max(damage::compressive_damage(law, p.wt, eps_eff));
+    }
+    // Plasticity (§9), in effective-stress space, with the undamaged force states.
+    if law.plasticity && p.wc < 1.0 {
+        let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
+        let ratio = plasticity::equivalent_stress_2d(&sigma, law.nu, law.plane) / f_eff;
+        if ratio >= 1.0 {
+            let mut fs = [0.0; K];
+            let bt = m.b[i] * theta_e;
+            for k in 0..K {
+                if used[k] {
+                    fs[k] = m.a[i] * se[k] + bt;
+                }
+            }
+            plasticity::flow(&fs, &used, ratio, law.fy / law.e, sps_trial);
+            p.yielded = true;
+        }
+    }
+    *trial = p;
+    b_theta
+}
+
+/// Pass 1 over all particles.
+fn pass_state<const K: usize>(
+    m: &Mechanics<2, K>,
+    c: &mut Concrete<K>,
+    x: &[Vector2<f64>],
+    b_theta: &mut [f64],
+) {
+    let mut trial = std::mem::take(&mut c.trial);
+    let mut sps_trial = std::mem::take(&mut c.sps_trial);
+    let mut cache = std::mem::take(&mut c.cache);
+    {
+        let c = &*c;
+        b_theta
+            .par_iter_mut()
+            .zip(trial.par_iter_mut())
+            .zip(sps_trial.par_iter_mut())
+            .zip(cache.par_iter_mut())
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(i, (((bt, tr), sp), ca))| *bt = update_state(m, c, x, i, tr, sp, ca));
+    }
+    c.trial = trial;
+    c.sps_trial = sps_trial;
+    c.cache = cache;
+}
+
+/// Internal force on particle i and the power of its bond dampers (half of each bond's),
+/// from the slot cache pass 1 left and every particle's bθ.
+#[inline]
+fn particle_force<const K: usize, const DAMP: bool>(
+    m: &Mechanics<2, K>,
+    c: &Concrete<K>,
+    v: &[Vector2<f64>],
+    b_theta: &[f64],
+    i: usize,
+) -> (Vector2<f64>, f64) {
+    let mut f = Vector2::zeros();
+    let mut power = 0.0;
+    for (s, &j) in c.cache[i].iter().zip(&m.neighbours[i]) {
+        if s.d == 0.0 {
+            continue;
+        }
+        let j = j as usize;
+        let mut fb = 0.5 * (s.d_a_se + s.sd * (b_theta[i] + b_theta[j]));
+        if DAMP {
+            let cb = s.d * 0.5 * (m.c_in[i] + m.c_in[j]);
+            let rate = (v[j] - v[i]).dot(&s.e);
+            fb += cb * rate;
+            power += 0.5 * cb * rate * rate;
+        }
+        f += s.e * fb;
+    }
+    (f, power)
+}
+
+/// One explicit step with damage and plasticity from x^n, v^{n−½} into `x_next`, `v_next`
+/// (not yet swapped in), `force` (the internal force at x^n) and the damper work; then the
+/// trial state is committed. With `LAG`, the force of the previous step drives this one
+/// (reading A of MODEL.md §4; `force_prev` holds it).
+pub fn step<const K: usize, const LAG: bool, const DAMP: bool>(
+    m: &Mechanics<2, K>,
+    c: &mut Concrete<K>,
+    st: &mut super::kernel::State<2>,
+    dt: f64,
+) {
+    pass_state(m, c, &st.x, &mut st.b_theta);
+    {
+        let c = &*c;
+        let (x, v, bt, fp) = (&st.x[..], &st.v[..], &st.b_theta[..], &st.force_prev[..]);
+        st.x_next
+            .par_iter_mut()
+            .zip(st.v_next.par_iter_mut())
+            .zip(st.force.par_iter_mut())
+            .zip(st.damping_work.par_iter_mut())
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(i, (((xn, vn), fo), dw))| {
+                let (f, bond_power) = particle_force::<K, DAMP>(m, c, v, bt, i);
+                *fo = f;
+                let drive = if LAG { fp[i] } else { f };
+                let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
+                let vi = v[i];
+                let vnew = (vi * (1.0 - h) + drive * (dt * m.inv_mass[i])) / (1.0 + h);
+                *vn = vnew;
+                *xn = x[i] + vnew * dt;
+                if DAMP || h != 0.0 {
+                    let vm = (vi + vnew) * 0.5;
+                    *dw += dt * (bond_power + m.c_ex[i] * vm.norm_squared());
+                }
+            });
+    }
+    c.commit();
+}
+
+/// Internal forces (bonds only, no dampers) at positions x with the committed state; the
+/// trial state is left as the step would compute it. For tests and post-processing.
+pub fn internal_forces<const K: usize>(
+    m: &Mechanics<2, K>,
+    c: &mut Concrete<K>,
+    x: &[Vector2<f64>],
+) -> Vec<Vector2<f64>> {
+    let mut bt = vec![0.0; x.len()];
+    pass_state(m, c, x, &mut bt);
+    let c = &*c;
+    (0..x.len())
+        .map(|i| particle_force::<K, false>(m, c, x, &bt, i).0)
+        .collect()
+}
+
+/// Elastic energy stored in the damaged bonds at positions x with the committed state,
+/// U = ¼·Σ_i Σ_k L0,k·S_e,k·(d_k·a_i·S_e,k + √d_k·bθ_i) (with fixed d and S_P,
+/// ∂U/∂L_ij = F_b,ij for equal bond lengths, as in the lattice).
+pub fn internal_energy<const K: usize>(
+    m: &Mechanics<2, K>,
+    c: &Concrete<K>,
+    x: &[Vector2<f64>],
+) -> f64 {
+    (0..x.len())
+        .into_par_iter()
+        .with_min_len(256)
+        .map(|i| {
+            let (sl, bt) = slots(m, c, x, i);
+            let mut u = 0.0;
+            for (k, s) in sl.iter().enumerate() {
+                if let Some(s) = s {
+                    u += c.l0[i][k] * s.se * (s.d * m.a[i] * s.se + s.sd * bt);
+                }
+            }
+            0.25 * u
+        })
+        .sum()
+}
+
+/// Particle stresses (3.18) with the damaged force states F_s,ij = d_ij·a_i·S_e,ij + √d_ij·bθ_i.
+pub fn particle_stress<const K: usize>(
+    m: &Mechanics<2, K>,
+    c: &Concrete<K>,
+    x: &[Vector2<f64>],
+) -> Vec<Matrix2<f64>> {
+    (0..x.len())
+        .map(|i| {
+            let (sl, bt) = slots(m, c, x, i);
+            let mut acc = StressSum::default();
+            for (k, s) in sl.iter().enumerate() {
+                if let Some(s) = s {
+                    acc.add(&s.e, c.l0[i][k], s.d * m.a[i] * s.se + s.sd * bt);
+                }
+            }
+            acc.finish(c.volume[i])
+        })
+        .collect()
+}
+
+/// A material model with state that replaces the elastic kernel for a run (dispatched once
+/// per step, never inside the particle loop).
+pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
+    /// One step (see [`step`]).
+    fn step(
+        &mut self,
+        m: &Mechanics<D, K>,
+        st: &mut super::kernel::State<D>,
+        dt: f64,
+        lag: bool,
+        damp: bool,
+    );
+    /// Elastic energy at positions x.
+    fn internal_energy(&self, m: &Mechanics<D, K>, x: &[nalgebra::SVector<f64, D>]) -> f64;
+    /// The damage state.
+    fn concrete(&self) -> &Concrete<K>;
+    fn concrete_mut(&mut self) -> &mut Concrete<K>;
+}
+
+impl<const K: usize> Inelastic<2, K> for Concrete<K> {
+    fn step(
+        &mut self,
+        m: &Mechanics<2, K>,
+        st: &mut super::kernel::State<2>,
+        dt: f64,
+        lag: bool,
+        damp: bool,
+    ) {
+        match (lag, damp) {
+            (false, false) => step::<K, false, false>(m, self, st, dt),
+            (false, true) => step::<K, false, true>(m, self, st, dt),
+            (true, false) => step::<K, true, false>(m, self, st, dt),
+            (true, true) => step::<K, true, true>(m, self, st, dt),
+        }
+    }
+    fn internal_energy(&self, m: &Mechanics<2, K>, x: &[Vector2<f64>]) -> f64 {
+        internal_energy(m, self, x)
+    }
+    fn concrete(&self) -> &Concrete<K> {
+        self
+    }
+    fn concrete_mut(&mut self) -> &mut Concrete<K> {
+        self
+    }
+}
