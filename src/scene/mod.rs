@@ -94,7 +94,9 @@ pub struct DiscretisationSpec {
     /// Per-particle micro-moduli for particles with missing bonds, fitted the SPPM way
     /// (MODEL.md §3, "surface correction"). Default off: on a plate in tension it makes the
     /// edges too stiff by about as much as they are too soft without it (E +0.25% on,
-    /// −0.20% off at W/L0 = 100; +1.02% / −0.77% at W/L0 = 25; tests/elastic_plate.rs).
+    /// −0.20% off at W/L0 = 100; +1.02% / −0.77% at W/L0 = 25; tests/elastic_plate.rs). On
+    /// peak loads it helps the tension block (0.957 → 1.000 × f't·A) but overshoots the
+    /// split cylinder (+2.3% → +3.8%) and dog-bone B (+0.2% → +3.0%) (benchmarks/RESULTS.md).
     #[serde(default)]
     pub surface_correction: bool,
 }
