@@ -79,6 +79,7 @@ fn bench(
         *x = x0 * (1.0 + strain);
     }
     let mut model = concrete.then(|| {
+        let cod_c = crate::material::concrete::critical_crack_opening(81.4, 2.6168e6, 0.1, 0.25);
         let law = crate::model::damage::ConcreteLaw {
             e: 30e9,
             nu: 0.2,
@@ -88,8 +89,8 @@ fn bench(
             fy: 22.983e6,
             fult: 27.58e6,
             gf: 81.4,
-            cod_c: 1.778e-4,
-            cod_1: 1.778e-5,
+            cod_c,
+            cod_1: 0.1 * cod_c,
             gamma: 0.25,
             eps_ult: 0.0035,
             wt_cr: 1.0 / 3.0,

@@ -525,7 +525,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
         .collect();
     let (stress, damage) = match &sim.inelastic {
         Some(model) => (
-            concrete::particle_stress(&sim.mech, model.concrete(), &x),
+            concrete::particle_stress(&sim.mech, model.concrete(), &x, &p.model.particles.volume),
             Some(model.concrete().committed.clone()),
         ),
         None => (

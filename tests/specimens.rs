@@ -3,10 +3,31 @@
 //! reaches the engineering peak and cracks across its narrow section; both, symmetric with a
 //! symmetric lattice, crack symmetrically.
 
-use sppm::run::{run, RunOptions};
+use sppm::run::{run, Outcome, RunOptions};
 use sppm::Scene;
 use std::collections::HashMap;
 use std::path::Path;
+
+/// Largest |w_t(x, y) − w_t(−x, y)| over the particles of a run whose lattice maps onto
+/// itself under x → −x.
+fn mirror_asymmetry(o: &Outcome) -> f64 {
+    let damage = o.damage.as_ref().unwrap();
+    let key = |x: f64, y: f64| ((x * 1e7).round() as i64, (y * 1e7).round() as i64);
+    let by_pos: HashMap<_, f64> =
+        o.x0.iter()
+            .zip(damage)
+            .map(|(x, w)| (key(x.x, x.y), w.wt))
+            .collect();
+    o.x0.iter()
+        .zip(damage)
+        .map(|(x, w)| {
+            let m = by_pos
+                .get(&key(-x.x, x.y))
+                .expect("the lattice is symmetric about x = 0");
+            (w.wt - m).abs()
+        })
+        .fold(0.0, f64::max)
+}
 
 #[test]
 fn split_cylinder_peak_crack_and_symmetry() {
@@ -61,19 +82,7 @@ fn split_cylinder_peak_crack_and_symmetry() {
         );
     }
     // Symmetry about the loaded diameter (x → −x maps the lattice onto itself at 0°).
-    let key = |x: f64, y: f64| ((x * 1e7).round() as i64, (y * 1e7).round() as i64);
-    let by_pos: HashMap<_, f64> =
-        o.x0.iter()
-            .zip(damage)
-            .map(|(x, w)| (key(x.x, x.y), w.wt))
-            .collect();
-    let mut worst: f64 = 0.0;
-    for (x, w) in o.x0.iter().zip(damage) {
-        let m = by_pos
-            .get(&key(-x.x, x.y))
-            .expect("the lattice is symmetric about x = 0");
-        worst = worst.max((w.wt - m).abs());
-    }
+    let worst = mirror_asymmetry(&o);
     println!("largest |w_t(x, y) − w_t(−x, y)| = {worst:.2e}");
     assert!(worst <= 0.01, "asymmetric crack pattern: {worst}");
 }
@@ -107,16 +116,6 @@ fn dogbone_b_peak_and_crack() {
             .collect();
     assert!(cracked.len() >= 15, "{} cracked particles", cracked.len());
     assert!(cracked.iter().all(|x| (x.y - 0.075).abs() <= 0.05));
-    let key = |x: f64, y: f64| ((x * 1e7).round() as i64, (y * 1e7).round() as i64);
-    let by_pos: HashMap<_, f64> =
-        o.x0.iter()
-            .zip(damage)
-            .map(|(x, w)| (key(x.x, x.y), w.wt))
-            .collect();
-    let worst =
-        o.x0.iter()
-            .zip(damage)
-            .map(|(x, w)| (w.wt - by_pos[&key(-x.x, x.y)]).abs())
-            .fold(0.0, f64::max);
+    let worst = mirror_asymmetry(&o);
     assert!(worst <= 0.01, "asymmetric crack pattern: {worst}");
 }

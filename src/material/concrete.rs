@@ -61,6 +61,15 @@ pub enum Preset {
 }
 
 impl Preset {
+    /// The name as a scene writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::SplmBlock => "splm_block",
+            Preset::SplmCylinder => "splm_cylinder",
+            Preset::SplmDogbone => "splm_dogbone",
+        }
+    }
+
     /// (f'c, d_max, f't if the source fixes it), SI.
     pub fn values(self) -> (f64, f64, Option<f64>) {
         match self {

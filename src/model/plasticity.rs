@@ -5,44 +5,24 @@
 //! √(3/2)·‖σ_dev‖/F_eff, yielding at 1.
 
 use crate::scene::Plane;
-use nalgebra::{Matrix2, Matrix3};
+use nalgebra::Matrix2;
 
-/// The 3×3 stress of a 2D particle: σ_zz = 0 (plane stress) or ν·(σxx + σyy) (plane strain).
-#[inline]
-pub fn stress_3d(s: &Matrix2<f64>, nu: f64, plane: Plane) -> Matrix3<f64> {
-    let szz = match plane {
-        Plane::Stress => 0.0,
-        Plane::Strain => nu * (s[(0, 0)] + s[(1, 1)]),
-    };
-    Matrix3::new(
-        s[(0, 0)],
-        s[(0, 1)],
-        0.0,
-        s[(1, 0)],
-        s[(1, 1)],
-        0.0,
-        0.0,
-        0.0,
-        szz,
-    )
-}
-
-/// Von Mises equivalent stress √(3/2)·‖σ_dev‖ (3.39), (3.40).
-#[inline]
-pub fn equivalent_stress(s: &Matrix3<f64>) -> f64 {
-    let dev = s - Matrix3::identity() * (s.trace() / 3.0);
-    (1.5 * dev.norm_squared()).sqrt()
-}
-
-/// Von Mises equivalent stress of a 2D particle from its in-plane stress, σ_zz as in
-/// [`stress_3d`]: the same value as `equivalent_stress(&stress_3d(..))` without 3×3 algebra.
+/// Out-of-plane stress σ_zz of a 2D particle: 0 in plane stress, ν·(σxx + σyy) (equally
+/// ν·(σ1 + σ2)) in plane strain.
 #[inline(always)]
-pub fn equivalent_stress_2d(s: &Matrix2<f64>, nu: f64, plane: Plane) -> f64 {
-    let (sx, sy, t) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
-    let sz = match plane {
+pub fn out_of_plane_stress(sxx: f64, syy: f64, nu: f64, plane: Plane) -> f64 {
+    match plane {
         Plane::Stress => 0.0,
-        Plane::Strain => nu * (sx + sy),
-    };
+        Plane::Strain => nu * (sxx + syy),
+    }
+}
+
+/// Von Mises equivalent stress √(3/2)·‖σ_dev‖ ((3.39), (3.40)) of a 2D particle from its
+/// in-plane stress, with σ_zz from [`out_of_plane_stress`].
+#[inline(always)]
+pub fn equivalent_stress(s: &Matrix2<f64>, nu: f64, plane: Plane) -> f64 {
+    let (sx, sy, t) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
+    let sz = out_of_plane_stress(sx, sy, nu, plane);
     (0.5 * ((sx - sy).powi(2) + (sy - sz).powi(2) + (sz - sx).powi(2)) + 3.0 * t * t).sqrt()
 }
 
@@ -98,21 +78,35 @@ mod tests {
 
     #[test]
     fn von_mises_of_uniaxial_and_shear() {
-        let s = stress_3d(&Matrix2::new(-30e6, 0.0, 0.0, 0.0), 0.2, Plane::Stress);
-        assert!((equivalent_stress(&s) - 30e6).abs() < 1e-6);
-        let t = stress_3d(&Matrix2::new(0.0, 10e6, 10e6, 0.0), 0.2, Plane::Stress);
-        assert!((equivalent_stress(&t) - 3f64.sqrt() * 10e6).abs() < 1e-6);
+        let s = Matrix2::new(-30e6, 0.0, 0.0, 0.0);
+        assert!((equivalent_stress(&s, 0.2, Plane::Stress) - 30e6).abs() < 1e-6);
+        let t = Matrix2::new(0.0, 10e6, 10e6, 0.0);
+        assert!((equivalent_stress(&t, 0.2, Plane::Stress) - 3f64.sqrt() * 10e6).abs() < 1e-6);
         // hydrostatic (plane strain, ν = 0.5 limit) is not yielding
-        let h = stress_3d(&Matrix2::new(-1e6, 0.0, 0.0, -1e6), 0.5, Plane::Strain);
-        assert!(equivalent_stress(&h) < 1e-6);
+        let h = Matrix2::new(-1e6, 0.0, 0.0, -1e6);
+        assert!(equivalent_stress(&h, 0.5, Plane::Strain) < 1e-6);
     }
 
+    /// The 2D form equals √(3/2)·‖σ − tr(σ)/3·I‖ of the full 3×3 tensor.
     #[test]
     fn two_d_equivalent_stress_matches_the_tensor_form() {
         let s = Matrix2::new(-30e6, 4e6, 4e6, 7e6);
         for plane in [Plane::Stress, Plane::Strain] {
-            let a = equivalent_stress(&stress_3d(&s, 0.2, plane));
-            let b = equivalent_stress_2d(&s, 0.2, plane);
+            let szz = out_of_plane_stress(s[(0, 0)], s[(1, 1)], 0.2, plane);
+            let full = nalgebra::Matrix3::new(
+                s[(0, 0)],
+                s[(0, 1)],
+                0.0,
+                s[(1, 0)],
+                s[(1, 1)],
+                0.0,
+                0.0,
+                0.0,
+                szz,
+            );
+            let dev = full - nalgebra::Matrix3::identity() * (full.trace() / 3.0);
+            let a = (1.5 * dev.norm_squared()).sqrt();
+            let b = equivalent_stress(&s, 0.2, plane);
             assert!((a - b).abs() <= 1e-9 * a);
         }
     }

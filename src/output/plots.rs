@@ -4,6 +4,7 @@
 use super::fields;
 use crate::run::Outcome;
 use crate::scene::Field;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -108,38 +109,88 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Bounds (x0, x1, y0, y1) of a drawing, in mm.
-type Bounds = (f64, f64, f64, f64);
+/// The particle drawing shared by the particle and crack maps: positions x0 + scale·u in mm,
+/// the bounds with a margin of one spacing, a plot area sized to the body's aspect ratio
+/// and the disc radius that makes neighbouring particles touch.
+struct Frame {
+    pos: Vec<(f64, f64)>,
+    x: std::ops::Range<f64>,
+    y: std::ops::Range<f64>,
+    plot_w: f64,
+    plot_h: f64,
+    radius: i32,
+}
 
-/// Particle positions x0 + scale·u in mm, and the drawing's bounds with a margin of one
-/// spacing.
-fn particle_positions_mm(o: &Outcome, scale: f64) -> (Vec<(f64, f64)>, Bounds) {
-    let pos: Vec<(f64, f64)> =
-        o.x0.iter()
-            .zip(&o.displacement)
-            .map(|(x, u)| ((x.x + scale * u.x) * 1e3, (x.y + scale * u.y) * 1e3))
-            .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in &pos {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
+impl Frame {
+    fn new(o: &Outcome, scale: f64) -> Frame {
+        let pos: Vec<(f64, f64)> =
+            o.x0.iter()
+                .zip(&o.displacement)
+                .map(|(x, u)| ((x.x + scale * u.x) * 1e3, (x.y + scale * u.y) * 1e3))
+                .collect();
+        let (mut x0, mut x1, mut y0, mut y1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for &(x, y) in &pos {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        let l0 = o.summary.spacing_m * 1e3;
+        let (x0, x1, y0, y1) = (x0 - l0, x1 + l0, y0 - l0, y1 + l0);
+        let plot_w = 700.0;
+        Frame {
+            pos,
+            x: x0..x1,
+            y: y0..y1,
+            plot_w,
+            plot_h: (plot_w * (y1 - y0) / (x1 - x0)).clamp(150.0, 1400.0),
+            radius: ((0.5 * l0 * plot_w / (x1 - x0)).round() as i32).max(1),
+        }
     }
-    let l0 = o.summary.spacing_m * 1e3;
-    (pos, (x0 - l0, x1 + l0, y0 - l0, y1 + l0))
+
+    /// Axes in mm on `area`, titled "<scene>: <what>" (with the magnification if any).
+    fn chart<'a, 'b>(
+        &self,
+        area: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+        o: &Outcome,
+        what: &str,
+        scale: f64,
+        x_desc: String,
+        x_label_area: u32,
+    ) -> anyhow::Result<ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>>
+    {
+        let title = if scale > 0.0 {
+            format!("{}: {what} (deformed ×{scale})", o.summary.scene)
+        } else {
+            format!("{}: {what}", o.summary.scene)
+        };
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(x_label_area)
+            .y_label_area_size(60)
+            .build_cartesian_2d(self.x.clone(), self.y.clone())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(x_desc)
+            .y_desc("y (mm)")
+            .draw()
+            .map_err(err)?;
+        Ok(chart)
+    }
 }
 
 /// particle_map.svg: every particle as a disc coloured by `field`, at x0 + scale·u.
 pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyhow::Result<()> {
     let values = fields::values(o, field);
-    let (pos, (x0, x1, y0, y1)) = particle_positions_mm(o, scale);
-    let l0 = o.summary.spacing_m * 1e3;
+    let frame = Frame::new(o, scale);
     // colour range: 1st to 99th percentile, so that a few boundary particles (whose
     // one-sided bond sums give low particle stresses) do not wash out the interior
     let mut sorted: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
@@ -150,42 +201,18 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
     };
     let (vmin, vmax) = (quantile(0.01), quantile(0.99));
     let span = if vmax > vmin { vmax - vmin } else { 1.0 };
-    // plot area sized to the body's aspect ratio
-    let plot_w = 700.0;
-    let plot_h = (plot_w * (y1 - y0) / (x1 - x0)).clamp(150.0, 1400.0);
-    let width = plot_w as u32 + 230;
-    let height = plot_h as u32 + 110;
+    let width = frame.plot_w as u32 + 230;
+    let height = frame.plot_h as u32 + 110;
     let root = SVGBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
     let (main, bar) = root.split_horizontally(width - 140);
-    let title = if scale > 0.0 {
-        format!(
-            "{}: {} (deformed ×{scale})",
-            o.summary.scene,
-            fields::label(field)
-        )
-    } else {
-        format!("{}: {}", o.summary.scene, fields::label(field))
-    };
-    let mut chart = ChartBuilder::on(&main)
-        .caption(title, ("sans-serif", 18))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x (mm)")
-        .y_desc("y (mm)")
-        .draw()
-        .map_err(err)?;
-    let px_per_mm = plot_w / (x1 - x0);
-    let radius = ((0.5 * l0 * px_per_mm).round() as i32).max(1);
+    let mut chart = frame.chart(&main, o, fields::label(field), scale, "x (mm)".into(), 40)?;
+    let radius = frame.radius;
     chart
         .draw_series(
-            pos.iter()
+            frame
+                .pos
+                .iter()
                 .zip(&values)
                 .map(|(&p, &v)| Circle::new(p, radius, viridis((v - vmin) / span).filled())),
         )
@@ -235,44 +262,25 @@ pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
     let Some(damage) = &o.damage else {
         return Ok(());
     };
-    let (pos, (x0, x1, y0, y1)) = particle_positions_mm(o, scale);
-    let l0 = o.summary.spacing_m * 1e3;
-    let plot_w = 700.0;
-    let plot_h = (plot_w * (y1 - y0) / (x1 - x0)).clamp(150.0, 1400.0);
-    let width = plot_w as u32 + 90;
-    let height = plot_h as u32 + 130;
+    let frame = Frame::new(o, scale);
+    let width = frame.plot_w as u32 + 90;
+    let height = frame.plot_h as u32 + 130;
     let root = SVGBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
     let cracked = damage.iter().filter(|p| p.wt >= 0.99).count();
     let crushed = damage.iter().filter(|p| p.wc >= 0.5 && p.wt < 0.99).count();
     let yielded = damage.iter().filter(|p| p.yielded).count();
-    let title = format!(
-        "{}: tensile damage{}",
-        o.summary.scene,
-        if scale > 0.0 {
-            format!(" (deformed ×{scale})")
-        } else {
-            String::new()
-        }
-    );
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 18))
-        .margin(10)
-        .x_label_area_size(60)
-        .y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc(format!(
+    let mut chart = frame.chart(
+        &root,
+        o,
+        "tensile damage",
+        scale,
+        format!(
             "x (mm)   —   red: w_t (grey 0 → dark red 1; {cracked} with w_t ≥ 0.99)   ×: w_c ≥ 0.5 ({crushed})   blue ring: yielded ({yielded})"
-        ))
-        .y_desc("y (mm)")
-        .draw()
-        .map_err(err)?;
-    let px_per_mm = plot_w / (x1 - x0);
-    let radius = ((0.5 * l0 * px_per_mm).round() as i32).max(1);
+        ),
+        60,
+    )?;
+    let (pos, radius) = (&frame.pos, frame.radius);
     chart
         .draw_series(
             pos.iter()

@@ -64,115 +64,58 @@ impl Scene {
                 "must be a finite number greater than zero",
             ));
         }
-        let preset = c.preset.map(|p| (p, p.values()));
-        let preset_name = |p: cc::Preset| {
-            format!(
-                "preset {}",
-                serde_json::to_value(p)
-                    .ok()
-                    .and_then(|v| v.as_str().map(str::to_string))
-                    .unwrap_or_default()
-            )
-        };
-        let (fc, fc_src) = match (c.fc, preset) {
-            (Some(v), _) => (v, "scene".to_string()),
-            (None, Some((p, (fc, _, _)))) => (fc, preset_name(p)),
-            (None, None) => {
-                return Err(invalid(
-                    "concrete.fc",
-                    "(missing)",
-                    "give the compressive strength f'c in Pa, or concrete.preset",
-                ))
-            }
-        };
-        self.record("fc", fc, &fc_src);
-        let e = match self.material.e {
-            Some(e) => {
-                self.record("E", e, "scene");
-                e
-            }
-            None => {
-                let e = cc::aci_youngs_modulus(fc, rho);
-                self.record(
-                    "E",
-                    e,
-                    "ACI 318-14: E = 33·rho^1.5·sqrt(f'c) [psi, lb/ft3] (5.2)",
-                );
-                self.material.e = Some(e);
-                e
-            }
-        };
-        let ft = match (c.ft, preset) {
-            (Some(v), _) => {
-                self.record("ft", v, "scene");
-                v
-            }
-            (None, Some((p, (_, _, Some(ft))))) => {
-                self.record("ft", ft, &preset_name(p));
-                ft
-            }
-            _ => {
-                let v = cc::aci_tensile_strength(fc);
-                self.record("ft", v, "ACI 318-92: f't = 6·sqrt(f'c) [psi] (5.1)");
-                v
-            }
-        };
-        let fy = c.fy.unwrap_or(5.0 / 6.0 * fc);
-        self.record(
-            "fy",
-            fy,
-            if c.fy.is_some() {
-                "scene"
-            } else {
-                "(5/6)·f'c"
-            },
-        );
-        let fult = c.fult.unwrap_or(fc);
-        self.record("fult", fult, if c.fult.is_some() { "scene" } else { "f'c" });
-        let gf = match c.gf {
-            Some(v) => {
-                self.record("Gf", v, "scene");
-                v
-            }
-            None => {
-                let gf0 = match c.gf0 {
-                    Some(v) => {
-                        self.record("Gf0", v, "scene");
-                        v
-                    }
-                    None => {
-                        let (dmax, src) = match (c.max_aggregate, preset) {
-                            (Some(d), _) => (d, "scene".to_string()),
-                            (None, Some((p, (_, d, _)))) => (d, preset_name(p)),
-                            (None, None) => {
-                                return Err(invalid(
-                                    "concrete.Gf",
-                                    "(missing)",
-                                    "give the fracture energy Gf in N/m, or Gf0, or max_aggregate (m) for the CEB-FIP 1990 correlation",
-                                ))
-                            }
-                        };
-                        self.record("max_aggregate", dmax, &src);
-                        let Some(gf0) = cc::base_fracture_energy(dmax) else {
-                            return Err(invalid(
-                                "concrete.max_aggregate",
-                                dmax,
-                                "one of 0.008, 0.016, 0.032 m (CEB-FIP 1990) or 0.019 m (the source); for another size give concrete.Gf0 or concrete.Gf",
-                            ));
-                        };
-                        self.record("Gf0", gf0, "CEB-FIP 1990 table for max_aggregate");
-                        gf0
-                    }
-                };
-                let v = cc::ceb_fip_fracture_energy(gf0, fc);
-                self.record(
-                    "Gf",
-                    v,
-                    "CEB-FIP 1990: Gf = Gf0·((f'c + 8 MPa)/10 MPa)^0.7 (5.3)",
-                );
-                v
-            }
-        };
+        // (f'c, d_max, f't) of the preset, with its source
+        let preset = c
+            .preset
+            .map(|p| (p.values(), format!("preset {}", p.name())));
+        let fc = self.take("fc", c.fc, |_| match &preset {
+            Some(((fc, _, _), src)) => Ok((*fc, src.clone())),
+            None => Err(invalid(
+                "concrete.fc",
+                "(missing)",
+                "give the compressive strength f'c in Pa, or concrete.preset",
+            )),
+        })?;
+        let e = self.take("E", self.material.e, |_| {
+            Ok((
+                cc::aci_youngs_modulus(fc, rho),
+                "ACI 318-14: E = 33·rho^1.5·sqrt(f'c) [psi, lb/ft3] (5.2)".into(),
+            ))
+        })?;
+        self.material.e = Some(e);
+        let ft = self.take("ft", c.ft, |_| match &preset {
+            Some(((_, _, Some(ft)), src)) => Ok((*ft, src.clone())),
+            _ => Ok((
+                cc::aci_tensile_strength(fc),
+                "ACI 318-92: f't = 6·sqrt(f'c) [psi] (5.1)".into(),
+            )),
+        })?;
+        let fy = self.take("fy", c.fy, |_| Ok((5.0 / 6.0 * fc, "(5/6)·f'c".into())))?;
+        let fult = self.take("fult", c.fult, |_| Ok((fc, "f'c".into())))?;
+        let gf = self.take("Gf", c.gf, |s| {
+            let gf0 = s.take("Gf0", c.gf0, |s| {
+                let dmax = s.take("max_aggregate", c.max_aggregate, |_| match &preset {
+                    Some(((_, d, _), src)) => Ok((*d, src.clone())),
+                    None => Err(invalid(
+                        "concrete.Gf",
+                        "(missing)",
+                        "give the fracture energy Gf in N/m, or Gf0, or max_aggregate (m) for the CEB-FIP 1990 correlation",
+                    )),
+                })?;
+                match cc::base_fracture_energy(dmax) {
+                    Some(g) => Ok((g, "CEB-FIP 1990 table for max_aggregate".into())),
+                    None => Err(invalid(
+                        "concrete.max_aggregate",
+                        dmax,
+                        "one of 0.008, 0.016, 0.032 m (CEB-FIP 1990) or 0.019 m (the source); for another size give concrete.Gf0 or concrete.Gf",
+                    )),
+                }
+            })?;
+            Ok((
+                cc::ceb_fip_fracture_energy(gf0, fc),
+                "CEB-FIP 1990: Gf = Gf0·((f'c + 8 MPa)/10 MPa)^0.7 (5.3)".into(),
+            ))
+        })?;
         // Ranges of the law's parameters.
         let frac = |key: &str, v: f64, lo_open: bool| -> Result<(), SceneError> {
             let ok = v.is_finite() && v < 1.0 && if lo_open { v > 0.0 } else { v >= 0.0 };
@@ -260,6 +203,22 @@ impl Scene {
         Ok(())
     }
 
+    /// The value the scene gives for `key`, else the one `derive` finds (with its source);
+    /// either way recorded in [`Scene::derived`].
+    fn take(
+        &mut self,
+        key: &str,
+        given: Option<f64>,
+        derive: impl FnOnce(&mut Scene) -> Result<(f64, String), SceneError>,
+    ) -> Result<f64, SceneError> {
+        let (value, source) = match given {
+            Some(v) => (v, "scene".to_string()),
+            None => derive(self)?,
+        };
+        self.record(key, value, &source);
+        Ok(value)
+    }
+
     fn record(&mut self, key: &str, value: f64, source: &str) {
         self.derived.push(Derived {
             key: key.into(),
@@ -277,17 +236,16 @@ impl Scene {
     pub fn concrete_law(&self) -> Option<ConcreteLaw> {
         let c = self.concrete.as_ref()?;
         let get = |k: &str| self.derived_value(k).unwrap_or(f64::NAN);
-        let (ft, gf) = (get("ft"), get("Gf"));
-        let cod_c = cc::critical_crack_opening(gf, ft, c.alpha, c.gamma);
+        let cod_c = get("COD_c");
         Some(ConcreteLaw {
             e: self.material.youngs_modulus(),
             nu: self.material.nu,
             plane: self.material.plane,
             fc: get("fc"),
-            ft,
+            ft: get("ft"),
             fy: get("fy"),
             fult: get("fult"),
-            gf,
+            gf: get("Gf"),
             cod_c,
             cod_1: c.alpha * cod_c,
             gamma: c.gamma,

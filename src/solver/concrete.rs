@@ -33,6 +33,7 @@
 //! under-reads at free surfaces (full ΔV, half the bonds) by up to ~60%, so cracks could
 //! neither start nor run through surface particles. The stress maps show (3.18).
 
+use super::kernel::central_difference;
 use super::mechanics::Mechanics;
 use crate::discretise::{Particles, NONE};
 use crate::model::damage::{self, ConcreteLaw};
@@ -68,8 +69,6 @@ pub struct Concrete<const K: usize> {
     /// Least-squares strain projector of each particle (reference bond directions).
     pub fit: Vec<StrainFit<K>>,
     pub reverse: Vec<[u8; K]>,
-    pub l0: Vec<[f64; K]>,
-    pub volume: Vec<f64>,
     /// Committed damage state (read by both passes of a step).
     pub committed: Vec<ParticleDamage>,
     trial: Vec<ParticleDamage>,
@@ -101,8 +100,6 @@ impl<const K: usize> Concrete<K> {
             d: elasticity_matrix(law.e, law.nu, law.plane),
             fit,
             reverse: p.reverse.clone(),
-            l0: p.l0.clone(),
-            volume: p.volume.clone(),
             committed: vec![ParticleDamage::default(); n],
             trial: vec![ParticleDamage::default(); n],
             sps: vec![[0.0; K]; n],
@@ -254,20 +251,18 @@ fn update_state<const K: usize>(
     let eps = strain::strain_tensor(&c.fit[i], &st);
     let (e1, e2, e3) = strain::principal_strains(&eps, law.nu, law.plane);
     let eps_eff = damage::effective_strain(e1, e2, e3);
-    let eps_d = strain::strain_tensor(&c.fit[i], &dse);
-    let sv = c.d * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
-    let sigma = Matrix2::new(sv[0], sv[2], sv[2], sv[1]);
+    // The criteria stress D·ε_d, needed only to test initiation and yield.
+    let criteria_stress = || {
+        let eps_d = strain::strain_tensor(&c.fit[i], &dse);
+        let sv = c.d * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
+        Matrix2::new(sv[0], sv[2], sv[2], sv[1])
+    };
 
     // Tensile damage (§8).
     if law.tensile_damage && !p.initiated {
-        let (s1, s2) = strain::principal_values(&sigma);
-        let s33 = match law.plane {
-            crate::scene::Plane::Stress => 0.0,
-            crate::scene::Plane::Strain => law.nu * (s1 + s2),
-        };
-        let p1 = s1.max(s33);
-        let p3 = s2.min(s33);
-        if damage::initiates(law, p1, p3) {
+        let (s1, s2) = strain::principal_values(&criteria_stress());
+        let s33 = plasticity::out_of_plane_stress(s1, s2, law.nu, law.plane);
+        if damage::initiates(law, s1.max(s33), s2.min(s33)) {
             p.initiated = true;
             p.eps_init = e1;
         }
@@ -279,10 +274,11 @@ fn update_state<const K: usize>(
     if law.compressive_damage {
         p.wc = p.wc.max(damage::compressive_damage(law, p.wt, eps_eff));
     }
-    // Plasticity (§9), in effective-stress space, with the undamaged force states.
+    // Plasticity (§9): yield on the criteria stress, flow along the deviatoric part of the
+    // undamaged force states (3.44).
     if law.plasticity && p.wc < 1.0 {
         let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
-        let ratio = plasticity::equivalent_stress_2d(&sigma, law.nu, law.plane) / f_eff;
+        let ratio = plasticity::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
         if ratio >= 1.0 {
             let mut fs = [0.0; K];
             let bt = m.b[i] * theta_e;
@@ -379,15 +375,9 @@ pub fn step<const K: usize, const LAG: bool, const DAMP: bool>(
                 let (f, bond_power) = particle_force::<K, DAMP>(m, c, v, bt, i);
                 *fo = f;
                 let drive = if LAG { fp[i] } else { f };
-                let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
-                let vi = v[i];
-                let vnew = (vi * (1.0 - h) + drive * (dt * m.inv_mass[i])) / (1.0 + h);
-                *vn = vnew;
-                *xn = x[i] + vnew * dt;
-                if DAMP || h != 0.0 {
-                    let vm = (vi + vnew) * 0.5;
-                    *dw += dt * (bond_power + m.c_ex[i] * vm.norm_squared());
-                }
+                central_difference::<2, K, DAMP>(
+                    m, i, x[i], v[i], drive, bond_power, dt, xn, vn, dw,
+                );
             });
     }
     c.commit();
@@ -424,7 +414,7 @@ pub fn internal_energy<const K: usize>(
             let mut u = 0.0;
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
-                    u += c.l0[i][k] * s.se * (s.d * m.a[i] * s.se + s.sd * bt);
+                    u += s.se * (s.d * m.a[i] * s.se + s.sd * bt) / m.inv_l0[i][k];
                 }
             }
             0.25 * u
@@ -432,11 +422,13 @@ pub fn internal_energy<const K: usize>(
         .sum()
 }
 
-/// Particle stresses (3.18) with the damaged force states F_s,ij = d_ij·a_i·S_e,ij + √d_ij·bθ_i.
+/// Particle stresses (3.18) of particles of volume ΔV with the damaged force states
+/// F_s,ij = d_ij·a_i·S_e,ij + √d_ij·bθ_i.
 pub fn particle_stress<const K: usize>(
     m: &Mechanics<2, K>,
     c: &Concrete<K>,
     x: &[Vector2<f64>],
+    volume: &[f64],
 ) -> Vec<Matrix2<f64>> {
     (0..x.len())
         .map(|i| {
@@ -444,10 +436,10 @@ pub fn particle_stress<const K: usize>(
             let mut acc = StressSum::default();
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
-                    acc.add(&s.e, c.l0[i][k], s.d * m.a[i] * s.se + s.sd * bt);
+                    acc.add(&s.e, 1.0 / m.inv_l0[i][k], s.d * m.a[i] * s.se + s.sd * bt);
                 }
             }
-            acc.finish(c.volume[i])
+            acc.finish(volume[i])
         })
         .collect()
 }

@@ -332,11 +332,31 @@ fn update_one<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>
         ..
     } = inp;
     let drive = if LAG { force_prev[i] } else { f };
+    central_difference::<D, K, DAMP>(m, i, x[i], v[i], drive, bond_power, dt, xn, vn, dw);
+}
+
+/// Central differences (3.58) for particle i at x_i, v_i^{n−½} driven by `drive`, with the
+/// particle damper (3.56) taken semi-implicitly; adds the work of its dampers (the bond
+/// dampers' `bond_power` and the particle damper's) over the step to `dw`. Shared by the
+/// elastic and the concrete kernels.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn central_difference<const D: usize, const K: usize, const DAMP: bool>(
+    m: &Mechanics<D, K>,
+    i: usize,
+    xi: SVector<f64, D>,
+    vi: SVector<f64, D>,
+    drive: SVector<f64, D>,
+    bond_power: f64,
+    dt: f64,
+    xn: &mut SVector<f64, D>,
+    vn: &mut SVector<f64, D>,
+    dw: &mut f64,
+) {
     let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
-    let vi = v[i];
     let vnew = (vi * (1.0 - h) + drive * (dt * m.inv_mass[i])) / (1.0 + h);
     *vn = vnew;
-    *xn = x[i] + vnew * dt;
+    *xn = xi + vnew * dt;
     if DAMP || h != 0.0 {
         let vm = (vi + vnew) * 0.5;
         *dw += dt * (bond_power + m.c_ex[i] * vm.norm_squared());
