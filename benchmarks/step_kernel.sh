@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Throughput of a step kernel (particle-steps per second) at 1e4, 1e5 and 1e6 particles with
 # 1 and 2 threads: the median of REPEATS runs of `sppm bench` each, all in one invocation so
-# that the figures are comparable. MODEL is "elastic" (default) or "concrete".
+# that the figures are comparable. MODEL is "elastic" (default), "tension" or "full".
 # Usage: benchmarks/step_kernel.sh [REPEATS] [MODEL]
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,13 +1,15 @@
-//! `sppm bench`: throughput of the step kernels (elastic, or with concrete damage and
-//! plasticity) on a square block of hexagonal lattice, in particle-steps per second (set-up
-//! excluded).
+//! `sppm bench`: throughput of the step kernels (elastic; tension: tensile damage only; full:
+//! two-spring damage and plasticity) on a square block of hexagonal lattice, in particle-steps
+//! per second (set-up excluded).
 
 use crate::discretise::hex::HexLattice;
 use crate::geometry::Shape2;
 use crate::model::micro_modulus;
 use crate::scene::Plane;
+use crate::solver::concrete::Inelastic;
 use crate::solver::kernel::{self, State};
 use crate::solver::mechanics::Mechanics;
+use crate::solver::KernelSet;
 use nalgebra::Vector2;
 use serde::Serialize;
 use std::time::Instant;
@@ -23,32 +25,17 @@ pub struct BenchResult {
     pub seconds: f64,
 }
 
-/// Time `steps` elastic steps (bond dampers on, as in the shipped scenes) of a square block
-/// of about `particles` particles on `threads` threads.
-pub fn bench_elastic(
+/// Time `steps` steps of `kernel` (bond dampers on, as in the shipped scenes) on a square
+/// block of about `particles` particles on `threads` threads. The tension and full kernels
+/// run the Table 1 concrete of 002, strained to 90% of f't/E so that every particle
+/// evaluates its criteria (and, with the full kernel, the yield test) in every step.
+pub fn bench(
     particles: usize,
     steps: usize,
     threads: usize,
+    kernel: KernelSet,
 ) -> anyhow::Result<BenchResult> {
-    bench(particles, steps, threads, false)
-}
-
-/// [`bench_elastic`] with the concrete kernel (damage and plasticity on, the Table 1
-/// concrete of 002, strained to 90% of f't/E so that every particle evaluates its criteria).
-pub fn bench_concrete(
-    particles: usize,
-    steps: usize,
-    threads: usize,
-) -> anyhow::Result<BenchResult> {
-    bench(particles, steps, threads, true)
-}
-
-fn bench(
-    particles: usize,
-    steps: usize,
-    threads: usize,
-    concrete: bool,
-) -> anyhow::Result<BenchResult> {
+    let concrete = kernel != KernelSet::Elastic;
     let l0 = 1e-3;
     let side = (particles as f64 * 0.5 * 3f64.sqrt()).sqrt() * l0;
     let shape = Shape2::Rectangle {
@@ -98,15 +85,20 @@ fn bench(
             initiation: crate::scene::Initiation::Rankine,
             crack_opening: crate::scene::CrackOpening::Total,
             tensile_damage: true,
-            compressive_damage: true,
-            plasticity: true,
+            compressive_damage: kernel == KernelSet::Full,
+            plasticity: kernel == KernelSet::Full,
             crack_band: 2.8 * l0,
         };
         crate::solver::concrete::Concrete::new(law, &p)
     });
+    let chosen = model.as_ref().map_or(KernelSet::Elastic, |c| c.kernel());
+    anyhow::ensure!(
+        chosen == kernel,
+        "the law chose the {chosen:?} kernel, not {kernel:?}"
+    );
     let mut one_step = |st: &mut State<2>| {
         match model.as_mut() {
-            Some(c) => crate::solver::concrete::step::<6, false, true>(&mech, c, st, dt),
+            Some(c) => c.step(&mech, st, dt, false, true),
             None => kernel::step::<2, 6, false, true>(&mech, st, dt),
         }
         std::mem::swap(&mut st.x, &mut st.x_next);
@@ -129,7 +121,7 @@ fn bench(
         particles: n,
         steps,
         threads,
-        model: if concrete { "concrete" } else { "elastic" }.into(),
+        model: kernel.name().into(),
         particle_steps_per_s: (n * steps) as f64 / seconds,
         seconds,
     })

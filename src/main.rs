@@ -53,7 +53,8 @@ enum Command {
         steps: usize,
         #[arg(long, default_value_t = 1)]
         threads: usize,
-        /// Kernel: "elastic", or "concrete" (two-spring damage and plasticity).
+        /// Kernel: "elastic", "tension" (tensile damage only) or "full" (two-spring damage and
+        /// plasticity; "concrete" is accepted for it).
         #[arg(long, default_value = "elastic")]
         model: String,
     },
@@ -165,18 +166,18 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 dim == 2,
                 "--dim {dim}: only 2 is available (3D arrives with the FCC lattice)"
             );
-            anyhow::ensure!(
-                model == "elastic" || model == "concrete",
-                "--model {model}: \"elastic\" or \"concrete\" (damage and plasticity)"
-            );
+            let kernel = match model.as_str() {
+                "elastic" => sppm::solver::KernelSet::Elastic,
+                "tension" => sppm::solver::KernelSet::Tension,
+                "full" | "concrete" => sppm::solver::KernelSet::Full,
+                _ => anyhow::bail!(
+                    "--model {model}: \"elastic\", \"tension\" (tensile damage only) or \"full\" (damage and plasticity)"
+                ),
+            };
             anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
             anyhow::ensure!(threads >= 1, "--threads {threads}: at least 1");
-            let r = if model == "concrete" {
-                sppm::bench::bench_concrete(particles, steps.max(1), threads)
-            } else {
-                sppm::bench::bench_elastic(particles, steps.max(1), threads)
-            }
-            .context("benchmark failed")?;
+            let r = sppm::bench::bench(particles, steps.max(1), threads, kernel)
+                .context("benchmark failed")?;
             println!("{}", serde_json::to_string(&r)?);
             Ok(ExitCode::SUCCESS)
         }

@@ -378,6 +378,8 @@ pub struct Summary {
     /// Material values and where each came from (scene, preset or correlation).
     pub material_values: Vec<crate::material::concrete::Derived>,
     pub force_lag: crate::scene::ForceLag,
+    /// The step kernel chosen for the scene's features: elastic, tension or full.
+    pub kernel: crate::solver::KernelSet,
     pub surface_correction: SurfaceCorrection,
     pub micro_modulus_a_bulk: f64,
     pub micro_modulus_b_bulk: f64,
@@ -535,6 +537,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
     };
     let summary = summarise(
         &p,
+        sim.kernel(),
         &records,
         wall,
         threads,
@@ -556,6 +559,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
 
 fn summarise(
     p: &Prepared,
+    kernel: crate::solver::KernelSet,
     records: &[Record],
     wall: f64,
     threads: usize,
@@ -638,6 +642,7 @@ fn summarise(
         concrete: p.model.scene.concrete_law(),
         material_values: p.model.scene.derived.clone(),
         force_lag: p.model.scene.solver.force_lag,
+        kernel,
         surface_correction: p.model.surface.clone(),
         micro_modulus_a_bulk: p.model.bulk.a,
         micro_modulus_b_bulk: p.model.bulk.b,

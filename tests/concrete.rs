@@ -272,3 +272,60 @@ fn concrete_results_do_not_depend_on_the_thread_count() {
         assert_eq!(a.force_n.to_bits(), b.force_n.to_bits());
     }
 }
+
+/// The kernel is chosen from the scene's features: a law with tensile damage only runs the
+/// tension kernel, which skips the plastic stretch, w_c and the yield test and gives the full
+/// kernel's results bit for bit (positions, damage, reactions) through cracking and failure;
+/// a law with plasticity or compressive damage runs the full kernel.
+#[test]
+fn tension_kernel_matches_the_full_kernel_bit_for_bit() {
+    let tension_only = [
+        "loading.end_periods=20",
+        "concrete.compressive_damage=false",
+        "concrete.plasticity=false",
+    ];
+    let scene = block(0.1, 0.01, &tension_only);
+    let mut runs = Vec::new();
+    for force_full in [false, true] {
+        let mut p = prepare(&scene).unwrap();
+        let mut sim = build_simulation(&mut p);
+        sim.inelastic.as_mut().unwrap().concrete_mut().force_full = force_full;
+        let probe = &p.probe.as_ref().unwrap().1;
+        let forces: Vec<f64> = (0..p.steps)
+            .filter_map(|_| sim.advance(Some(probe)).map(|r| r.force_n))
+            .collect();
+        let c = sim.inelastic.as_ref().unwrap().concrete();
+        runs.push((
+            sim.kernel(),
+            forces,
+            sim.state.x.clone(),
+            c.committed.clone(),
+        ));
+    }
+    let (tension, full) = (&runs[0], &runs[1]);
+    assert_eq!(tension.0, sppm::solver::KernelSet::Tension);
+    assert_eq!(full.0, sppm::solver::KernelSet::Full);
+    assert!(
+        tension.3.iter().any(|d| d.wt >= 1.0),
+        "the block must break for the comparison to cover damage"
+    );
+    assert_eq!(tension.2, full.2);
+    assert_eq!(tension.3, full.3);
+    for (a, b) in tension.1.iter().zip(&full.1) {
+        assert_eq!(a.to_bits(), b.to_bits());
+    }
+    // the summary names the kernel of each feature set
+    let kernel_of = |o: &[&str]| {
+        let mut p = prepare(&block(0.1, 0.01, o)).unwrap();
+        build_simulation(&mut p).kernel()
+    };
+    assert_eq!(
+        kernel_of(&tension_only[1..]),
+        sppm::solver::KernelSet::Tension
+    );
+    assert_eq!(kernel_of(&[]), sppm::solver::KernelSet::Full);
+    assert_eq!(
+        kernel_of(&["concrete.plasticity=false"]),
+        sppm::solver::KernelSet::Full
+    );
+}

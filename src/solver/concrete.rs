@@ -35,6 +35,7 @@
 
 use super::kernel::central_difference;
 use super::mechanics::Mechanics;
+use super::KernelSet;
 use crate::discretise::{Particles, NONE};
 use crate::model::damage::{self, ConcreteLaw};
 use crate::model::micro_modulus::elasticity_matrix;
@@ -77,6 +78,9 @@ pub struct Concrete<const K: usize> {
     sps_trial: Vec<[f64; K]>,
     /// Scratch from pass 1 for pass 2 of the same step.
     cache: Vec<[SlotCache; K]>,
+    /// Run the full kernel even where the law needs only the tension kernel (for tests that
+    /// compare the two).
+    pub force_full: bool,
 }
 
 impl<const K: usize> Concrete<K> {
@@ -105,6 +109,17 @@ impl<const K: usize> Concrete<K> {
             sps: vec![[0.0; K]; n],
             sps_trial: vec![[0.0; K]; n],
             cache: vec![[SlotCache::default(); K]; n],
+            force_full: false,
+        }
+    }
+
+    /// The step kernel this law needs: the tension kernel unless it has compressive damage
+    /// or plasticity (ARCHITECTURE.md, "skip what the scene does not need").
+    pub fn kernel(&self) -> KernelSet {
+        if self.force_full || self.law.compressive_damage || self.law.plasticity {
+            KernelSet::Full
+        } else {
+            KernelSet::Tension
         }
     }
 
@@ -139,8 +154,11 @@ struct Slot {
 /// The slot of particle i in direction k, or `None` if empty. Computed identically from
 /// either end of the bond (S_T, S_P and d are symmetric bit for bit), so the two particles
 /// of a bond see the same elastic stretch and damage factor.
+///
+/// With `FULL = false` (the tension kernel: no plasticity, no compressive damage) the plastic
+/// stretch is zero and w_c stays zero, so neither is read.
 #[inline(always)]
-fn slot<const K: usize>(
+fn slot<const K: usize, const FULL: bool>(
     m: &Mechanics<2, K>,
     c: &Concrete<K>,
     x: &[Vector2<f64>],
@@ -155,14 +173,19 @@ fn slot<const K: usize>(
     let dx = x[j] - x[i];
     let len = dx.norm();
     let st = total_stretch(len, m.inv_l0[i][k]);
-    let r = c.reverse[i][k] as usize;
-    let sp = 0.5 * (c.sps[i][k] + c.sps[j][r]);
-    let se = st - sp;
+    let se = if FULL {
+        let r = c.reverse[i][k] as usize;
+        st - 0.5 * (c.sps[i][k] + c.sps[j][r])
+    } else {
+        st
+    };
     let (pi, pj) = (&c.committed[i], &c.committed[j]);
     let (wi, wj) = if se >= 0.0 {
         (pi.wt, pj.wt)
-    } else {
+    } else if FULL {
         (pi.wc, pj.wc)
+    } else {
+        (0.0, 0.0)
     };
     // The undamaged bond (most of them) skips the division and the square root.
     let (d, sd) = if wi == 0.0 && wj == 0.0 {
@@ -182,7 +205,7 @@ fn slot<const K: usize>(
 
 /// All slots of particle i and its damaged dilatation term bθ_i = b_i·Σ_m √d_im·S_e,im.
 #[inline(always)]
-fn slots<const K: usize>(
+fn slots<const K: usize, const FULL: bool>(
     m: &Mechanics<2, K>,
     c: &Concrete<K>,
     x: &[Vector2<f64>],
@@ -191,7 +214,7 @@ fn slots<const K: usize>(
     let mut out = [None; K];
     let mut theta = 0.0;
     for (k, o) in out.iter_mut().enumerate() {
-        *o = slot(m, c, x, i, k);
+        *o = slot::<K, FULL>(m, c, x, i, k);
         if let Some(s) = o {
             theta += s.sd * s.se;
         }
@@ -200,8 +223,13 @@ fn slots<const K: usize>(
 }
 
 /// Pass 1 for particle i: bθ_i, and the trial damage and plastic stretch state.
+///
+/// `FULL = false` is the tension kernel (tensile damage only): it reads no plastic stretch and
+/// no w_c, and evaluates neither ε_eff, compressive damage nor the yield criterion. On a law
+/// without compressive damage and plasticity it gives the same numbers as `FULL = true`, bit
+/// for bit.
 #[inline]
-fn update_state<const K: usize>(
+fn update_state<const K: usize, const FULL: bool>(
     m: &Mechanics<2, K>,
     c: &Concrete<K>,
     x: &[Vector2<f64>],
@@ -210,7 +238,7 @@ fn update_state<const K: usize>(
     sps_trial: &mut [f64; K],
     cache: &mut [SlotCache; K],
 ) -> f64 {
-    let (sl, b_theta) = slots(m, c, x, i);
+    let (sl, b_theta) = slots::<K, FULL>(m, c, x, i);
     for k in 0..K {
         cache[k] = match sl[k] {
             Some(s) => {
@@ -227,8 +255,10 @@ fn update_state<const K: usize>(
     }
     let law = &c.law;
     let mut p = c.committed[i];
-    *sps_trial = c.sps[i];
-    if p.wt >= 1.0 && p.wc >= 1.0 {
+    if FULL {
+        *sps_trial = c.sps[i];
+    }
+    if p.wt >= 1.0 && (p.wc >= 1.0 || !FULL) {
         *trial = p;
         return b_theta;
     }
@@ -237,6 +267,9 @@ fn update_state<const K: usize>(
     let mut dse = [0.0; K];
     let mut used = [false; K];
     let mut theta_e = 0.0;
+    // The damaged elastic stretches equal the total ones (undamaged bonds, no plastic
+    // stretch): one strain fit serves both.
+    let mut same = true;
     for k in 0..K {
         if let Some(s) = sl[k] {
             st[k] = s.st;
@@ -244,51 +277,66 @@ fn update_state<const K: usize>(
             dse[k] = s.d * s.se;
             used[k] = true;
             theta_e += s.se;
+            same &= dse[k] == st[k];
         }
     }
     // Strains (§7): total for the damage law and ε_eff; the criteria stress from the damaged
     // elastic stretches.
-    let eps = strain::strain_tensor(&c.fit[i], &st);
-    let (e1, e2, e3) = strain::principal_strains(&eps, law.nu, law.plane);
-    let eps_eff = damage::effective_strain(e1, e2, e3);
+    let fit = &c.fit[i];
+    let eps = strain::strain_tensor(fit, &st);
     // The criteria stress D·ε_d, needed only to test initiation and yield.
     let criteria_stress = || {
-        let eps_d = strain::strain_tensor(&c.fit[i], &dse);
+        let eps_d = if same {
+            eps
+        } else {
+            strain::strain_tensor(fit, &dse)
+        };
         let sv = c.d * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
         Matrix2::new(sv[0], sv[2], sv[2], sv[1])
     };
 
     // Tensile damage (§8).
+    let mut initiates_now = false;
     if law.tensile_damage && !p.initiated {
         let (s1, s2) = strain::principal_values(&criteria_stress());
         let s33 = plasticity::out_of_plane_stress(s1, s2, law.nu, law.plane);
-        if damage::initiates(law, s1.max(s33), s2.min(s33)) {
-            p.initiated = true;
-            p.eps_init = e1;
-        }
+        initiates_now = damage::initiates(law, s1.max(s33), s2.min(s33));
+    }
+    if !FULL && !(p.initiated || initiates_now) {
+        *trial = p;
+        return b_theta;
+    }
+    let (e1, e2, e3) = strain::principal_strains(&eps, law.nu, law.plane);
+    if initiates_now {
+        p.initiated = true;
+        p.eps_init = e1;
     }
     if p.initiated {
         p.wt = p.wt.max(damage::tensile_damage(law, e1, p.eps_init));
     }
-    // Compressive damage (§9).
-    if law.compressive_damage {
-        p.wc = p.wc.max(damage::compressive_damage(law, p.wt, eps_eff));
-    }
-    // Plasticity (§9): yield on the criteria stress, flow along the deviatoric part of the
-    // undamaged force states (3.44).
-    if law.plasticity && p.wc < 1.0 {
-        let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
-        let ratio = plasticity::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
-        if ratio >= 1.0 {
-            let mut fs = [0.0; K];
-            let bt = m.b[i] * theta_e;
-            for k in 0..K {
-                if used[k] {
-                    fs[k] = m.a[i] * se[k] + bt;
+    if FULL {
+        let eps_eff = damage::effective_strain(e1, e2, e3);
+        // Compressive damage (§9).
+        if law.compressive_damage {
+            p.wc = p.wc.max(damage::compressive_damage(law, p.wt, eps_eff));
+        }
+        // Plasticity (§9): yield on the criteria stress, flow along the deviatoric part of the
+        // undamaged force states (3.44).
+        if law.plasticity && p.wc < 1.0 {
+            let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
+            let ratio =
+                plasticity::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
+            if ratio >= 1.0 {
+                let mut fs = [0.0; K];
+                let bt = m.b[i] * theta_e;
+                for k in 0..K {
+                    if used[k] {
+                        fs[k] = m.a[i] * se[k] + bt;
+                    }
                 }
+                plasticity::flow(&fs, &used, ratio, law.fy / law.e, sps_trial);
+                p.yielded = true;
             }
-            plasticity::flow(&fs, &used, ratio, law.fy / law.e, sps_trial);
-            p.yielded = true;
         }
     }
     *trial = p;
@@ -296,7 +344,7 @@ fn update_state<const K: usize>(
 }
 
 /// Pass 1 over all particles.
-fn pass_state<const K: usize>(
+fn pass_state<const K: usize, const FULL: bool>(
     m: &Mechanics<2, K>,
     c: &mut Concrete<K>,
     x: &[Vector2<f64>],
@@ -314,7 +362,9 @@ fn pass_state<const K: usize>(
             .zip(cache.par_iter_mut())
             .enumerate()
             .with_min_len(256)
-            .for_each(|(i, (((bt, tr), sp), ca))| *bt = update_state(m, c, x, i, tr, sp, ca));
+            .for_each(|(i, (((bt, tr), sp), ca))| {
+                *bt = update_state::<K, FULL>(m, c, x, i, tr, sp, ca)
+            });
     }
     c.trial = trial;
     c.sps_trial = sps_trial;
@@ -353,14 +403,16 @@ fn particle_force<const K: usize, const DAMP: bool>(
 /// One explicit step with damage and plasticity from x^n, v^{n−½} into `x_next`, `v_next`
 /// (not yet swapped in), `force` (the internal force at x^n) and the damper work; then the
 /// trial state is committed. With `LAG`, the force of the previous step drives this one
-/// (reading A of MODEL.md §4; `force_prev` holds it).
-pub fn step<const K: usize, const LAG: bool, const DAMP: bool>(
+/// (reading A of MODEL.md §4; `force_prev` holds it). `FULL = false` is the tension kernel
+/// (see [`update_state`]), valid only for a law without compressive damage and plasticity.
+pub fn step<const K: usize, const LAG: bool, const DAMP: bool, const FULL: bool>(
     m: &Mechanics<2, K>,
     c: &mut Concrete<K>,
     st: &mut super::kernel::State<2>,
     dt: f64,
 ) {
-    pass_state(m, c, &st.x, &mut st.b_theta);
+    debug_assert!(FULL || c.kernel() == KernelSet::Tension);
+    pass_state::<K, FULL>(m, c, &st.x, &mut st.b_theta);
     {
         let c = &*c;
         let (x, v, bt, fp) = (&st.x[..], &st.v[..], &st.b_theta[..], &st.force_prev[..]);
@@ -391,7 +443,10 @@ pub fn internal_forces<const K: usize>(
     x: &[Vector2<f64>],
 ) -> Vec<Vector2<f64>> {
     let mut bt = vec![0.0; x.len()];
-    pass_state(m, c, x, &mut bt);
+    match c.kernel() {
+        KernelSet::Tension => pass_state::<K, false>(m, c, x, &mut bt),
+        _ => pass_state::<K, true>(m, c, x, &mut bt),
+    }
     let c = &*c;
     (0..x.len())
         .map(|i| particle_force::<K, false>(m, c, x, &bt, i).0)
@@ -410,7 +465,7 @@ pub fn internal_energy<const K: usize>(
         .into_par_iter()
         .with_min_len(256)
         .map(|i| {
-            let (sl, bt) = slots(m, c, x, i);
+            let (sl, bt) = slots::<K, true>(m, c, x, i);
             let mut u = 0.0;
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
@@ -432,7 +487,7 @@ pub fn particle_stress<const K: usize>(
 ) -> Vec<Matrix2<f64>> {
     (0..x.len())
         .map(|i| {
-            let (sl, bt) = slots(m, c, x, i);
+            let (sl, bt) = slots::<K, true>(m, c, x, i);
             let mut acc = StressSum::default();
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
@@ -472,11 +527,16 @@ impl<const K: usize> Inelastic<2, K> for Concrete<K> {
         lag: bool,
         damp: bool,
     ) {
-        match (lag, damp) {
-            (false, false) => step::<K, false, false>(m, self, st, dt),
-            (false, true) => step::<K, false, true>(m, self, st, dt),
-            (true, false) => step::<K, true, false>(m, self, st, dt),
-            (true, true) => step::<K, true, true>(m, self, st, dt),
+        let full = self.kernel() == KernelSet::Full;
+        match (lag, damp, full) {
+            (false, false, false) => step::<K, false, false, false>(m, self, st, dt),
+            (false, true, false) => step::<K, false, true, false>(m, self, st, dt),
+            (true, false, false) => step::<K, true, false, false>(m, self, st, dt),
+            (true, true, false) => step::<K, true, true, false>(m, self, st, dt),
+            (false, false, true) => step::<K, false, false, true>(m, self, st, dt),
+            (false, true, true) => step::<K, false, true, true>(m, self, st, dt),
+            (true, false, true) => step::<K, true, false, true>(m, self, st, dt),
+            (true, true, true) => step::<K, true, true, true>(m, self, st, dt),
         }
     }
     fn internal_energy(&self, m: &Mechanics<2, K>, x: &[Vector2<f64>]) -> f64 {

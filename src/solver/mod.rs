@@ -17,6 +17,28 @@ use nalgebra::SVector;
 
 use crate::scene::Ramp;
 
+/// The step kernel a run uses, chosen once before the loop from the features the scene turns
+/// on (ARCHITECTURE.md, "skip what the scene does not need"): the elastic kernel (no
+/// `[concrete]`), the tension kernel (tensile damage only: no plastic stretch, no w_c, no
+/// yield test), or the full kernel (compressive damage and/or plasticity).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum KernelSet {
+    Elastic,
+    Tension,
+    Full,
+}
+
+impl KernelSet {
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelSet::Elastic => "elastic",
+            KernelSet::Tension => "tension",
+            KernelSet::Full => "full",
+        }
+    }
+}
+
 /// How the run integrates.
 #[derive(Clone, Copy, Debug)]
 pub struct Integration {
@@ -99,6 +121,14 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             energy_scale: 0.0,
             bond_dampers,
             inelastic: None,
+        }
+    }
+
+    /// The step kernel this simulation runs.
+    pub fn kernel(&self) -> KernelSet {
+        match &self.inelastic {
+            Some(model) => model.concrete().kernel(),
+            None => KernelSet::Elastic,
         }
     }
 
