@@ -302,7 +302,7 @@ fn update_state<const K: usize, const FULL: bool>(
         let s33 = plasticity::out_of_plane_stress(s1, s2, law.nu, law.plane);
         initiates_now = damage::initiates(law, s1.max(s33), s2.min(s33));
     }
-    if !FULL && !(p.initiated || initiates_now) {
+    if !(FULL || p.initiated || initiates_now) {
         *trial = p;
         return b_theta;
     }
