@@ -317,11 +317,19 @@ fn plot(
             .label(*p)
             .legend(move |(x, yy)| Circle::new((x + 10, yy), 5, c.filled()));
     }
+    // the front as a staircase: the best error reached by each wall time
+    let mut stairs = Vec::new();
+    for (k, q) in front.iter().enumerate() {
+        if k > 0 {
+            stairs.push((q.0, y(front[k - 1].1)));
+        }
+        stairs.push((q.0, y(q.1)));
+    }
+    if let Some(last) = front.last() {
+        stairs.push((t1 * 1.25, y(last.1)));
+    }
     chart
-        .draw_series(LineSeries::new(
-            front.iter().map(|q| (q.0, y(q.1))),
-            BLACK.stroke_width(2),
-        ))
+        .draw_series(LineSeries::new(stairs, BLACK.stroke_width(2)))
         .map_err(|x| e(&x))?
         .label("Pareto front")
         .legend(|(x, yy)| PathElement::new(vec![(x, yy), (x + 20, yy)], BLACK.stroke_width(2)));
@@ -335,7 +343,7 @@ fn plot(
         .configure_series_labels()
         .border_style(BLACK)
         .background_style(WHITE.mix(0.85))
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
         .draw()
         .map_err(|x| e(&x))?;
     root.present().map_err(|x| e(&x))?;
