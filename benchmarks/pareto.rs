@@ -109,6 +109,11 @@ fn parse_args() -> anyhow::Result<Args> {
     Ok(a)
 }
 
+/// x to six decimals.
+fn round6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
 fn read_runs(path: &Path) -> anyhow::Result<Vec<SweepRun>> {
     if !path.exists() {
         return Ok(vec![]);
@@ -158,8 +163,9 @@ fn main() -> anyhow::Result<()> {
             label: label.clone(),
             parameter: parameter.into(),
             spacing_m: s.spacing_m,
-            end_periods: s.t_end_s / s.fundamental_period_s,
-            safety: s.safety,
+            // t_end/T1 and dt/dt_stable give back the scene's values to round-off
+            end_periods: round6(s.t_end_s / s.fundamental_period_s),
+            safety: round6(s.safety),
             internal_damping: scene.damping.internal,
             external_damping: scene.damping.external,
             particles: s.particles,
