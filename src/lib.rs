@@ -13,6 +13,7 @@ pub mod output;
 pub mod run;
 pub mod scene;
 pub mod solver;
+pub mod study;
 
 pub use run::{run, Outcome, RunOptions};
 pub use scene::Scene;

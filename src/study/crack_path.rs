@@ -1,0 +1,142 @@
+//! The crack path of a damaged specimen, as numbers: the cracked particles (w_t ≥ 0.99,
+//! the `cracked_particles` of summary.json), their centroid, the principal axis of their
+//! reference positions and their RMS distance from that axis. A straight crack has a
+//! well-defined axis and a width of about one crack band; a crack along the loaded diameter of
+//! a split cylinder has axis ≈ 90° and centroid x ≈ 0; the crack of a block in tension runs
+//! across the load, axis ≈ 0° (or just under 180°: the axis is a direction, not a vector).
+
+use nalgebra::Vector2;
+use serde::Serialize;
+
+/// Tensile damage at and above which a particle counts as cracked (as in summary.json).
+pub const CRACKED: f64 = 0.99;
+
+/// The principal line through a set of cracked particles.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CrackPath {
+    /// Number of cracked particles.
+    pub particles: usize,
+    /// Direction of the principal axis (largest variance), degrees in [0, 180).
+    pub axis_deg: f64,
+    /// RMS distance of the cracked particles from the axis line through their centroid (m).
+    pub rms_width_m: f64,
+    /// Centroid of the cracked particles (m).
+    pub centroid_m: [f64; 2],
+}
+
+/// The crack path of the particles at reference positions `x0` whose tensile damage `wt`
+/// is at least [`CRACKED`]; `None` when fewer than two particles are cracked (no axis).
+/// Principal component analysis of the 2×2 covariance C: the axis angle is
+/// ½·atan2(2·C_xy, C_xx − C_yy) and the RMS distance from it is √λ_min.
+pub fn crack_path(x0: &[Vector2<f64>], wt: &[f64]) -> Option<CrackPath> {
+    let pts: Vec<Vector2<f64>> = x0
+        .iter()
+        .zip(wt)
+        .filter(|(_, &w)| w >= CRACKED)
+        .map(|(x, _)| *x)
+        .collect();
+    principal_line(&pts)
+}
+
+/// The principal line of a point set (at least two points).
+pub fn principal_line(pts: &[Vector2<f64>]) -> Option<CrackPath> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let c = pts.iter().sum::<Vector2<f64>>() / n;
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    for p in pts {
+        let d = p - c;
+        sxx += d.x * d.x;
+        syy += d.y * d.y;
+        sxy += d.x * d.y;
+    }
+    let (sxx, syy, sxy) = (sxx / n, syy / n, sxy / n);
+    let mut axis = 0.5 * (2.0 * sxy).atan2(sxx - syy).to_degrees();
+    if axis < 0.0 {
+        axis += 180.0;
+    }
+    if axis >= 180.0 {
+        axis -= 180.0;
+    }
+    // smaller eigenvalue of [[sxx, sxy], [sxy, syy]]
+    let mean = 0.5 * (sxx + syy);
+    let half = (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt();
+    let lambda_min = (mean - half).max(0.0);
+    Some(CrackPath {
+        particles: pts.len(),
+        axis_deg: axis,
+        rms_width_m: lambda_min.sqrt(),
+        centroid_m: [c.x, c.y],
+    })
+}
+
+/// Angle between two axes (degrees in [0, 90]): axes are directions, so 179° and 1° are 2° apart.
+pub fn axis_difference_deg(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(180.0);
+    d.min(180.0 - d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(angle_deg: f64, centre: [f64; 2], n: usize, offsets: &[f64]) -> Vec<Vector2<f64>> {
+        let (s, c) = angle_deg.to_radians().sin_cos();
+        let dir = Vector2::new(c, s);
+        let normal = Vector2::new(-s, c);
+        let mut pts = Vec::new();
+        for k in 0..n {
+            let t = (k as f64 - 0.5 * (n - 1) as f64) * 0.01;
+            for &o in offsets {
+                pts.push(Vector2::new(centre[0], centre[1]) + t * dir + o * normal);
+            }
+        }
+        pts
+    }
+
+    #[test]
+    fn a_straight_line_has_its_angle_zero_width_and_centre() {
+        for angle in [0.0, 30.0, 90.0, 135.0, 179.0] {
+            let p = principal_line(&line(angle, [0.02, -0.01], 21, &[0.0])).unwrap();
+            assert!(
+                axis_difference_deg(p.axis_deg, angle) < 1e-9,
+                "{angle}: {p:?}"
+            );
+            assert!((0.0..180.0).contains(&p.axis_deg));
+            assert!(p.rms_width_m < 1e-12, "{p:?}");
+            assert!((p.centroid_m[0] - 0.02).abs() < 1e-12);
+            assert!((p.centroid_m[1] + 0.01).abs() < 1e-12);
+            assert_eq!(p.particles, 21);
+        }
+    }
+
+    #[test]
+    fn a_band_of_two_rows_has_the_half_separation_as_rms_width() {
+        // two parallel rows ±w from the axis: every point is w away from it
+        let p = principal_line(&line(90.0, [0.0, 0.0], 31, &[-0.003, 0.003])).unwrap();
+        assert!(axis_difference_deg(p.axis_deg, 90.0) < 1e-9);
+        assert!((p.rms_width_m - 0.003).abs() < 1e-12, "{p:?}");
+    }
+
+    #[test]
+    fn only_cracked_particles_count() {
+        let x0 = vec![
+            Vector2::new(0.0, 0.0),
+            Vector2::new(1.0, 0.0),
+            Vector2::new(0.5, 7.0),
+        ];
+        let p = crack_path(&x0, &[1.0, 0.995, 0.5]).unwrap();
+        assert_eq!(p.particles, 2);
+        assert!(p.axis_deg.abs() < 1e-12);
+        assert!(crack_path(&x0, &[1.0, 0.2, 0.5]).is_none());
+    }
+
+    #[test]
+    fn axis_difference_wraps_at_180() {
+        assert!((axis_difference_deg(179.0, 1.0) - 2.0).abs() < 1e-12);
+        assert!((axis_difference_deg(90.0, 0.0) - 90.0).abs() < 1e-12);
+        assert!((axis_difference_deg(10.0, 170.0) - 20.0).abs() < 1e-12);
+    }
+}
