@@ -101,6 +101,8 @@ fn objectivity_writes_rows_plots_and_crack_maps_and_resumes() {
         "crack_rms_width_m",
         "crack_centroid_x_m",
         "crack_centroid_y_m",
+        "crack_core_axis_deg",
+        "crack_core_rms_width_m",
     ] {
         assert!(
             header.split(',').any(|c| c == col),

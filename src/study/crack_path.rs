@@ -72,6 +72,35 @@ pub fn principal_line(pts: &[Vector2<f64>]) -> Option<CrackPath> {
     })
 }
 
+/// The core of the crack: the principal line of the cracked particles whose position along
+/// the principal axis of all of them lies in the middle half (between the 25% and 75%
+/// quantiles). Damage at the ends of a crack (under the loading strips of a split cylinder,
+/// at the grips) weighs on the axis of the whole set; the core is the crack itself.
+pub fn crack_core(x0: &[Vector2<f64>], wt: &[f64]) -> Option<CrackPath> {
+    let pts: Vec<Vector2<f64>> = x0
+        .iter()
+        .zip(wt)
+        .filter(|(_, &w)| w >= CRACKED)
+        .map(|(x, _)| *x)
+        .collect();
+    core_line(&pts)
+}
+
+/// The principal line of the middle half of a point set along its principal axis.
+pub fn core_line(pts: &[Vector2<f64>]) -> Option<CrackPath> {
+    let all = principal_line(pts)?;
+    let (s, c) = all.axis_deg.to_radians().sin_cos();
+    let centre = Vector2::new(all.centroid_m[0], all.centroid_m[1]);
+    let mut along: Vec<(f64, Vector2<f64>)> = pts
+        .iter()
+        .map(|p| ((p - centre).dot(&Vector2::new(c, s)), *p))
+        .collect();
+    along.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let n = along.len();
+    let middle: Vec<Vector2<f64>> = along[n / 4..n - n / 4].iter().map(|a| a.1).collect();
+    principal_line(&middle)
+}
+
 /// Angle between two axes (degrees in [0, 90]): axes are directions, so 179° and 1° are 2° apart.
 pub fn axis_difference_deg(a: f64, b: f64) -> f64 {
     let d = (a - b).rem_euclid(180.0);
@@ -131,6 +160,24 @@ mod tests {
         assert_eq!(p.particles, 2);
         assert!(p.axis_deg.abs() < 1e-12);
         assert!(crack_path(&x0, &[1.0, 0.2, 0.5]).is_none());
+    }
+
+    #[test]
+    fn the_core_is_the_crack_without_the_damage_at_its_ends() {
+        // an inclined crack through the centre (41 points over ±50 mm at 70°) with a
+        // horizontal row of damage at each end (under the strips of a split cylinder)
+        let mut pts = line(70.0, [0.0, 0.0], 41, &[0.0]);
+        pts.iter_mut().for_each(|p| *p *= 0.25); // spacing 2.5 mm
+        for y in [-0.06, 0.06] {
+            pts.extend((0..5).map(|k| Vector2::new(-0.02 + 0.01 * k as f64, y)));
+        }
+        let all = principal_line(&pts).unwrap();
+        let core = core_line(&pts).unwrap();
+        assert!(axis_difference_deg(all.axis_deg, 70.0) > 5.0, "{all:?}");
+        assert!(axis_difference_deg(core.axis_deg, 70.0) < 1e-9, "{core:?}");
+        // √λ_min carries the round-off of λ_max (~1e-3 m²): √(1e-16·1e-3) ≈ 3e-10 m
+        assert!(core.rms_width_m < 1e-8, "{core:?} {all:?}");
+        assert!(core.particles >= 20 && core.particles <= 27, "{core:?}");
     }
 
     #[test]

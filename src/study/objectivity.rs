@@ -8,7 +8,7 @@
 //! drawn from `seed` and k alone. The same (u, v) is used at every angle, so that adding an
 //! angle or an offset leaves the other runs (and their rows) unchanged.
 
-use super::crack_path::{crack_path, CrackPath};
+use super::crack_path::{crack_core, crack_path};
 use super::runner::{RunResult, Study, Variant};
 use crate::run::Outcome;
 use crate::Scene;
@@ -72,40 +72,37 @@ pub fn lattice_offset(
 }
 
 /// The crack-path columns of the objectivity CSV.
-pub const CRACK_COLUMNS: [&str; 5] = [
+pub const CRACK_COLUMNS: [&str; 9] = [
     "cracked_particles",
     "crack_axis_deg",
     "crack_rms_width_m",
     "crack_centroid_x_m",
     "crack_centroid_y_m",
+    "crack_core_axis_deg",
+    "crack_core_rms_width_m",
+    "crack_core_centroid_x_m",
+    "crack_core_centroid_y_m",
 ];
 
+/// The crack-path columns of a run: the principal line of all cracked particles and of the
+/// crack's core ([`super::crack_path`]); NaN where fewer than two particles cracked.
 fn crack_metrics(o: &Outcome) -> Vec<f64> {
-    let path: Option<CrackPath> = o.damage.as_ref().and_then(|d| {
-        let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
-        crack_path(&o.x0, &wt)
-    });
-    match path {
-        Some(p) => vec![
-            p.particles as f64,
-            p.axis_deg,
-            p.rms_width_m,
-            p.centroid_m[0],
-            p.centroid_m[1],
-        ],
-        None => {
-            let n = o
-                .damage
-                .as_ref()
-                .map(|d| {
-                    d.iter()
-                        .filter(|p| p.wt >= super::crack_path::CRACKED)
-                        .count()
-                })
-                .unwrap_or(0);
-            vec![n as f64, f64::NAN, f64::NAN, f64::NAN, f64::NAN]
+    let Some(d) = &o.damage else {
+        return [vec![0.0], vec![f64::NAN; CRACK_COLUMNS.len() - 1]].concat();
+    };
+    let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    let cracked = wt
+        .iter()
+        .filter(|w| **w >= super::crack_path::CRACKED)
+        .count();
+    let mut v = vec![cracked as f64];
+    for line in [crack_path(&o.x0, &wt), crack_core(&o.x0, &wt)] {
+        match line {
+            Some(p) => v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]]),
+            None => v.extend([f64::NAN; 4]),
         }
     }
+    v
 }
 
 /// A value at its extreme among the runs.
@@ -170,6 +167,7 @@ pub struct AngleSummary {
     pub mean_dissipated_energy_j: f64,
     pub mean_crack_axis_deg: Option<f64>,
     pub mean_crack_centroid_x_m: Option<f64>,
+    pub mean_crack_core_axis_deg: Option<f64>,
 }
 
 /// objectivity.json.
@@ -313,6 +311,11 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
                 ),
                 mean_crack_centroid_x_m: mean_of(
                     rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
+                ),
+                mean_crack_core_axis_deg: mean_of(
+                    rs.iter()
+                        .map(|r| metric(r, "crack_core_axis_deg"))
+                        .collect(),
                 ),
             }
         })
