@@ -101,6 +101,19 @@ pub fn core_line(pts: &[Vector2<f64>]) -> Option<CrackPath> {
     principal_line(&middle)
 }
 
+/// Mean of axes (degrees in [0, 180)): the doubled-angle circular mean, so that the mean of
+/// 179° and 1° is 0°, not 90°. `None` for no axes or axes that cancel.
+pub fn mean_axis_deg(axes: &[f64]) -> Option<f64> {
+    let (s, c) = axes.iter().fold((0.0, 0.0), |(s, c), a| {
+        let (sa, ca) = (2.0 * a.to_radians()).sin_cos();
+        (s + sa, c + ca)
+    });
+    if axes.is_empty() || s.hypot(c) < 1e-9 * axes.len() as f64 {
+        return None;
+    }
+    Some((0.5 * s.atan2(c).to_degrees()).rem_euclid(180.0))
+}
+
 /// Angle between two axes (degrees in [0, 90]): axes are directions, so 179° and 1° are 2° apart.
 pub fn axis_difference_deg(a: f64, b: f64) -> f64 {
     let d = (a - b).rem_euclid(180.0);
@@ -178,6 +191,15 @@ mod tests {
         // √λ_min carries the round-off of λ_max (~1e-3 m²): √(1e-16·1e-3) ≈ 3e-10 m
         assert!(core.rms_width_m < 1e-8, "{core:?} {all:?}");
         assert!(core.particles >= 20 && core.particles <= 27, "{core:?}");
+    }
+
+    #[test]
+    fn the_mean_of_axes_wraps_at_180() {
+        assert!(axis_difference_deg(mean_axis_deg(&[179.0, 1.0]).unwrap(), 0.0) < 1e-9);
+        assert!((mean_axis_deg(&[80.0, 100.0, 90.0]).unwrap() - 90.0).abs() < 1e-9);
+        assert!((mean_axis_deg(&[30.0]).unwrap() - 30.0).abs() < 1e-9);
+        assert_eq!(mean_axis_deg(&[0.0, 90.0]), None);
+        assert_eq!(mean_axis_deg(&[]), None);
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! drawn from `seed` and k alone. The same (u, v) is used at every angle, so that adding an
 //! angle or an offset leaves the other runs (and their rows) unchanged.
 
-use super::crack_path::{crack_core, crack_path};
+use super::crack_path::{crack_core, crack_path, mean_axis_deg};
 use super::runner::{RunResult, Study, Variant};
 use crate::run::Outcome;
 use crate::Scene;
@@ -165,6 +165,7 @@ pub struct AngleSummary {
     pub mean_peak_force_n: f64,
     #[serde(rename = "mean_dissipated_energy_J")]
     pub mean_dissipated_energy_j: f64,
+    /// Mean axes over the offsets: the doubled-angle mean ([`mean_axis_deg`]).
     pub mean_crack_axis_deg: Option<f64>,
     pub mean_crack_centroid_x_m: Option<f64>,
     pub mean_crack_core_axis_deg: Option<f64>,
@@ -306,16 +307,20 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
                     rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
                 )
                 .unwrap_or(f64::NAN),
-                mean_crack_axis_deg: mean_of(
-                    rs.iter().map(|r| metric(r, "crack_axis_deg")).collect(),
+                mean_crack_axis_deg: mean_axis_deg(
+                    &rs.iter()
+                        .map(|r| metric(r, "crack_axis_deg"))
+                        .filter(|a| a.is_finite())
+                        .collect::<Vec<_>>(),
                 ),
                 mean_crack_centroid_x_m: mean_of(
                     rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
                 ),
-                mean_crack_core_axis_deg: mean_of(
-                    rs.iter()
+                mean_crack_core_axis_deg: mean_axis_deg(
+                    &rs.iter()
                         .map(|r| metric(r, "crack_core_axis_deg"))
-                        .collect(),
+                        .filter(|a| a.is_finite())
+                        .collect::<Vec<_>>(),
                 ),
             }
         })
