@@ -97,6 +97,7 @@ fn objectivity_writes_rows_plots_and_crack_maps_and_resumes() {
         "wall_time_s",
         "status",
         "cracked_particles",
+        "crack_particles",
         "crack_axis_deg",
         "crack_rms_width_m",
         "crack_centroid_x_m",
@@ -139,6 +140,7 @@ fn objectivity_writes_rows_plots_and_crack_maps_and_resumes() {
             .unwrap();
     assert_eq!(json["runs"], 4);
     assert!(json["seed"].as_u64().is_some());
+    assert_eq!(json["crack_damage"], 0.9);
     assert!(json["peak_force"]["spread"].as_f64().unwrap() >= 0.0);
 
     // Started again: nothing runs, the CSV is unchanged and the line is the same.

@@ -1,6 +1,7 @@
 //! `sppm study objectivity|convergence`: the command-line face of the studies.
 
 use super::convergence::{convergence, ConvergenceArgs};
+use super::crack_path::CRACK_PATH_DAMAGE;
 use super::objectivity::{objectivity, ObjectivityArgs, DEFAULT_SEED};
 use super::runner::default_jobs;
 use anyhow::bail;
@@ -23,6 +24,9 @@ pub enum StudyCommand {
         /// Seed of the random offsets (recorded in objectivity.csv and objectivity.json).
         #[arg(long, default_value_t = DEFAULT_SEED)]
         seed: u64,
+        /// Tensile damage w_t at and above which a particle belongs to the crack path.
+        #[arg(long, default_value_t = CRACK_PATH_DAMAGE)]
+        crack_damage: f64,
         /// Override a scene value in every run (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
@@ -86,12 +90,14 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
             angles,
             offsets,
             seed,
+            crack_damage,
             set,
             out,
             jobs,
             quiet,
         } => {
             let report = objectivity(&ObjectivityArgs {
+                crack_damage,
                 scene,
                 angles_deg: parse_list("--angles", &angles)?,
                 offsets,

@@ -27,6 +27,8 @@ pub struct ObjectivityArgs {
     /// Random offsets per angle (besides the scene's own offset).
     pub offsets: usize,
     pub seed: u64,
+    /// Tensile damage at and above which a particle belongs to the crack path.
+    pub crack_damage: f64,
     pub overrides: Vec<String>,
     pub out: Option<PathBuf>,
     pub jobs: usize,
@@ -72,8 +74,9 @@ pub fn lattice_offset(
 }
 
 /// The crack-path columns of the objectivity CSV.
-pub const CRACK_COLUMNS: [&str; 9] = [
+pub const CRACK_COLUMNS: [&str; 10] = [
     "cracked_particles",
+    "crack_particles",
     "crack_axis_deg",
     "crack_rms_width_m",
     "crack_centroid_x_m",
@@ -86,17 +89,17 @@ pub const CRACK_COLUMNS: [&str; 9] = [
 
 /// The crack-path columns of a run: the principal line of all cracked particles and of the
 /// crack's core ([`super::crack_path`]); NaN where fewer than two particles cracked.
-fn crack_metrics(o: &Outcome) -> Vec<f64> {
+fn crack_metrics(o: &Outcome, threshold: f64) -> Vec<f64> {
     let Some(d) = &o.damage else {
-        return [vec![0.0], vec![f64::NAN; CRACK_COLUMNS.len() - 1]].concat();
+        return [vec![0.0, 0.0], vec![f64::NAN; CRACK_COLUMNS.len() - 2]].concat();
     };
     let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
-    let cracked = wt
-        .iter()
-        .filter(|w| **w >= super::crack_path::CRACKED)
-        .count();
-    let mut v = vec![cracked as f64];
-    for line in [crack_path(&o.x0, &wt), crack_core(&o.x0, &wt)] {
+    let count = |t: f64| wt.iter().filter(|w| **w >= t).count() as f64;
+    let mut v = vec![count(super::crack_path::CRACKED), count(threshold)];
+    for line in [
+        crack_path(&o.x0, &wt, threshold),
+        crack_core(&o.x0, &wt, threshold),
+    ] {
         match line {
             Some(p) => v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]]),
             None => v.extend([f64::NAN; 4]),
@@ -180,6 +183,8 @@ pub struct ObjectivityReport {
     pub angles_deg: Vec<f64>,
     pub random_offsets_per_angle: usize,
     pub seed: u64,
+    /// Tensile damage at and above which a particle belongs to the crack path.
+    pub crack_damage: f64,
     pub runs: usize,
     pub completed: usize,
     pub peak_force: Option<Spread>,
@@ -232,6 +237,12 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     if args.jobs == 0 {
         bail!("--jobs 0: at least 1");
     }
+    if !(args.crack_damage > 0.0 && args.crack_damage <= 1.0) {
+        bail!(
+            "--crack-damage {}: a tensile damage w_t with 0 < w_t <= 1",
+            args.crack_damage
+        );
+    }
     let base = Scene::from_file(&args.scene, &args.overrides)?;
     let d = &base.discretisation;
     let dir = args
@@ -252,7 +263,8 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
             });
         }
     }
-    let metrics = crack_metrics;
+    let threshold = args.crack_damage;
+    let metrics = move |o: &Outcome| crack_metrics(o, threshold);
     let study = Study {
         scene: args.scene.clone(),
         base_overrides: args.overrides.clone(),
@@ -266,6 +278,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
             "scene_file": args.scene.display().to_string(),
             "overrides": args.overrides,
             "seed": args.seed,
+            "crack_damage": args.crack_damage,
         }),
         jobs: args.jobs,
         progress: args.progress,
@@ -332,6 +345,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         angles_deg: args.angles_deg.clone(),
         random_offsets_per_angle: args.offsets,
         seed: args.seed,
+        crack_damage: args.crack_damage,
         runs: results.len(),
         completed: results.iter().filter(|r| r.row.completed()).count(),
         peak_force: spread(&results, |r| r.row.peak_force_n),
