@@ -58,6 +58,11 @@ enum Command {
         #[arg(long, default_value = "elastic")]
         model: String,
     },
+    /// Many runs of one scene: lattice objectivity or convergence with the spacing.
+    Study {
+        #[command(subcommand)]
+        study: sppm::study::cli::StudyCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -181,5 +186,6 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             println!("{}", serde_json::to_string(&r)?);
             Ok(ExitCode::SUCCESS)
         }
+        Command::Study { study } => sppm::study::cli::dispatch(study),
     }
 }

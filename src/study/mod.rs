@@ -1,3 +1,20 @@
-//! Studies: many runs of one scene, aggregated (ARCHITECTURE.md, "Studies").
+//! Studies: many runs of one scene that differ in a few values, run in parallel, each
+//! finished run written at once so that a study resumes where it stopped.
+//!
+//! - [`runner`]: the generic parallel runner of scene variants and its CSV.
+//! - [`objectivity`]: lattice rotations and offsets (peak-force spread, crack path).
+//! - [`convergence`]: lattice spacings (Richardson reference and observed order).
+//! - [`crack_path`], [`extrapolation`]: the pure functions the studies report with.
+//! - [`plots`]: the overlay and convergence plots; [`cli`]: the `sppm study` command.
+//! - [`pareto`]: run time against error (`benchmarks/pareto.rs`).
 
+pub mod cli;
+pub mod convergence;
+pub mod crack_path;
+pub mod extrapolation;
+pub mod objectivity;
 pub mod pareto;
+pub mod plots;
+pub mod runner;
+
+pub use runner::{RunResult, RunRow, Study, Variant};

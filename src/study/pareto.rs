@@ -6,6 +6,7 @@
 //! few combinations of a coarse lattice with short loading. The error of a run is the deviation
 //! of its peak load from a converged reference ([`reference`]).
 
+use super::extrapolation::richardson;
 use serde::{Deserialize, Serialize};
 
 /// One run of a sweep.
@@ -46,37 +47,6 @@ pub struct Reference {
     pub reference_n: f64,
 }
 
-/// Richardson extrapolation of f(h) = f0 + C·h^p from three (h, f) pairs, any refinement
-/// ratios: returns (f0, Some(p)), or (finest f, None) when the differences change sign or the
-/// order is not in (0.05, 20) (no monotone convergence to extrapolate).
-pub fn richardson(points: [(f64, f64); 3]) -> (f64, Option<f64>) {
-    let mut pts = points;
-    pts.sort_by(|a, b| b.0.total_cmp(&a.0)); // coarse to fine
-    let [(h1, f1), (h2, f2), (h3, f3)] = pts;
-    let (d12, d23) = (f1 - f2, f2 - f3);
-    if d12 == 0.0 || d23 == 0.0 || d12.signum() != d23.signum() {
-        return (f3, None);
-    }
-    let target = d12 / d23;
-    let ratio = |p: f64| (h1.powf(p) - h2.powf(p)) / (h2.powf(p) - h3.powf(p));
-    // ratio(p) increases monotonically with p for h1 > h2 > h3
-    let (mut lo, mut hi) = (0.05, 20.0);
-    if !(ratio(lo) <= target && target <= ratio(hi)) {
-        return (f3, None);
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if ratio(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let p = 0.5 * (lo + hi);
-    let c = d23 / (h2.powf(p) - h3.powf(p));
-    (f3 - c * h3.powf(p), Some(p))
-}
-
 /// The converged reference: the spacing sweep extrapolated to L0 → 0, corrected by how much
 /// the longest loading and the smallest safety factor change the peak at the default spacing
 /// (the three errors taken as independent and additive). None without a default run and at
@@ -94,7 +64,12 @@ pub fn reference(runs: &[SweepRun]) -> Option<Reference> {
     if spacing.len() < 3 {
         return None;
     }
-    let (f0, order) = richardson([spacing[0], spacing[1], spacing[2]]);
+    // coarse to fine
+    let r = richardson(
+        [spacing[2].0, spacing[1].0, spacing[0].0],
+        [spacing[2].1, spacing[1].1, spacing[0].1],
+    );
+    let (f0, order) = (r.reference, r.order);
     let extreme = |parameter: &str, key: fn(&SweepRun) -> f64, longest: bool| {
         ok.iter()
             .filter(|r| r.parameter == parameter)
@@ -161,26 +136,6 @@ pub fn nearness(front: &[(f64, f64)], t: f64, e: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn richardson_recovers_a_power_law_with_any_ratio() {
-        for (p, hs) in [
-            (1.0, [0.01, 0.005, 0.0025]),
-            (2.0, [0.01, 0.005, 0.0025]),
-            (1.5, [0.012, 0.007, 0.0031]),
-        ] {
-            let f = |h: f64| 230.0e3 + 4.0e6 * h.powf(p);
-            let (f0, order) = richardson([(hs[0], f(hs[0])), (hs[1], f(hs[1])), (hs[2], f(hs[2]))]);
-            assert!((f0 / 230.0e3 - 1.0).abs() < 1e-9, "{f0}");
-            assert!((order.unwrap() - p).abs() < 1e-6);
-        }
-    }
-
-    #[test]
-    fn richardson_refuses_oscillating_data() {
-        let (f0, order) = richardson([(0.01, 1.0), (0.005, 2.0), (0.0025, 1.5)]);
-        assert_eq!((f0, order), (1.5, None));
-    }
 
     #[test]
     fn reference_extrapolates_spacing_and_adds_the_loading_and_step_corrections() {

@@ -1,0 +1,391 @@
+//! The objectivity study: the same scene at several lattice rotations, each with the
+//! scene's own lattice offset (offset 0) and N random offsets, to measure how much the
+//! peak force, the energy and the crack path depend on how the lattice sits in the body
+//! (VALIDATION.md §B–C: the goal is a peak-force spread of at most 3%).
+//!
+//! Random offsets are uniform in the lattice cell: offset k ≥ 1 adds u·a1 + v·a2 to the
+//! scene's offset, with a1, a2 the rotated lattice vectors and (u, v) uniform in [0, 1)²
+//! drawn from `seed` and k alone. The same (u, v) is used at every angle, so that adding an
+//! angle or an offset leaves the other runs (and their rows) unchanged.
+
+use super::crack_path::{crack_core, crack_path, mean_axis_deg};
+use super::runner::{RunResult, Study, Variant};
+use crate::run::Outcome;
+use crate::Scene;
+use anyhow::bail;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// The default seed of the random offsets (recorded in the CSV and objectivity.json).
+pub const DEFAULT_SEED: u64 = 20_240_401;
+
+/// The study's inputs.
+#[derive(Clone, Debug)]
+pub struct ObjectivityArgs {
+    pub scene: PathBuf,
+    pub angles_deg: Vec<f64>,
+    /// Random offsets per angle (besides the scene's own offset).
+    pub offsets: usize,
+    pub seed: u64,
+    /// Tensile damage at and above which a particle belongs to the crack path.
+    pub crack_damage: f64,
+    pub overrides: Vec<String>,
+    pub out: Option<PathBuf>,
+    pub jobs: usize,
+    pub progress: bool,
+}
+
+/// SplitMix64 (Steele, Lea and Flood 2014): a small, well-mixed generator, enough for
+/// uniform offsets and the same on every platform.
+fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The fractional position (u, v) in [0, 1)² of random offset `k` (k ≥ 1) for `seed`.
+pub fn offset_fraction(seed: u64, k: usize) -> (f64, f64) {
+    let a = splitmix64(seed ^ splitmix64(2 * k as u64));
+    let b = splitmix64(seed ^ splitmix64(2 * k as u64 + 1));
+    let unit = |x: u64| (x >> 11) as f64 / (1u64 << 53) as f64;
+    (unit(a), unit(b))
+}
+
+/// The offset (m) of offset `k` at `angle_deg` for a lattice of `spacing` whose scene offset is
+/// `base`: `base` for k = 0, else base + u·a1 + v·a2.
+pub fn lattice_offset(
+    seed: u64,
+    k: usize,
+    angle_deg: f64,
+    spacing: f64,
+    base: [f64; 2],
+) -> [f64; 2] {
+    if k == 0 {
+        return base;
+    }
+    let (u, v) = offset_fraction(seed, k);
+    let (s, c) = angle_deg.to_radians().sin_cos();
+    // a1 = R(θ)(L0, 0), a2 = R(θ)(L0/2, L0·√3/2) (src/discretise/hex.rs)
+    let (a1x, a1y) = (spacing * c, spacing * s);
+    let (bx, by) = (0.5 * spacing, 0.5 * 3f64.sqrt() * spacing);
+    let (a2x, a2y) = (c * bx - s * by, s * bx + c * by);
+    [base[0] + u * a1x + v * a2x, base[1] + u * a1y + v * a2y]
+}
+
+/// The crack-path columns of the objectivity CSV.
+pub const CRACK_COLUMNS: [&str; 10] = [
+    "cracked_particles",
+    "crack_particles",
+    "crack_axis_deg",
+    "crack_rms_width_m",
+    "crack_centroid_x_m",
+    "crack_centroid_y_m",
+    "crack_core_axis_deg",
+    "crack_core_rms_width_m",
+    "crack_core_centroid_x_m",
+    "crack_core_centroid_y_m",
+];
+
+/// The crack-path columns of a run: the principal line of all cracked particles and of the
+/// crack's core ([`super::crack_path`]); NaN where fewer than two particles cracked.
+fn crack_metrics(o: &Outcome, threshold: f64) -> Vec<f64> {
+    let Some(d) = &o.damage else {
+        return [vec![0.0, 0.0], vec![f64::NAN; CRACK_COLUMNS.len() - 2]].concat();
+    };
+    let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    let count = |t: f64| wt.iter().filter(|w| **w >= t).count() as f64;
+    let mut v = vec![count(super::crack_path::CRACKED), count(threshold)];
+    for line in [
+        crack_path(&o.x0, &wt, threshold),
+        crack_core(&o.x0, &wt, threshold),
+    ] {
+        match line {
+            Some(p) => v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]]),
+            None => v.extend([f64::NAN; 4]),
+        }
+    }
+    v
+}
+
+/// A value at its extreme among the runs.
+#[derive(Clone, Debug, Serialize)]
+pub struct Extreme {
+    pub label: String,
+    pub value: f64,
+}
+
+/// Spread (max − min)/mean of one quantity over the completed runs.
+#[derive(Clone, Debug, Serialize)]
+pub struct Spread {
+    pub runs: usize,
+    pub mean: f64,
+    pub min: Extreme,
+    pub max: Extreme,
+    /// (max − min)/mean.
+    pub spread: f64,
+}
+
+/// (max − min)/mean of `value` over `results` that completed; `None` if none did.
+pub fn spread(results: &[RunResult], value: impl Fn(&RunResult) -> f64) -> Option<Spread> {
+    let ok: Vec<&RunResult> = results
+        .iter()
+        .filter(|r| r.row.completed() && value(r).is_finite())
+        .collect();
+    if ok.is_empty() {
+        return None;
+    }
+    let mean = ok.iter().map(|r| value(r)).sum::<f64>() / ok.len() as f64;
+    let lo = ok
+        .iter()
+        .min_by(|a, b| value(a).total_cmp(&value(b)))
+        .unwrap();
+    let hi = ok
+        .iter()
+        .max_by(|a, b| value(a).total_cmp(&value(b)))
+        .unwrap();
+    Some(Spread {
+        runs: ok.len(),
+        mean,
+        min: Extreme {
+            label: lo.row.label.clone(),
+            value: value(lo),
+        },
+        max: Extreme {
+            label: hi.row.label.clone(),
+            value: value(hi),
+        },
+        spread: (value(hi) - value(lo)) / mean,
+    })
+}
+
+/// Per-angle means over the offsets.
+#[derive(Clone, Debug, Serialize)]
+pub struct AngleSummary {
+    pub angle_deg: f64,
+    pub runs: usize,
+    #[serde(rename = "mean_peak_force_N")]
+    pub mean_peak_force_n: f64,
+    #[serde(rename = "mean_dissipated_energy_J")]
+    pub mean_dissipated_energy_j: f64,
+    /// Mean axes over the offsets: the doubled-angle mean ([`mean_axis_deg`]).
+    pub mean_crack_axis_deg: Option<f64>,
+    pub mean_crack_centroid_x_m: Option<f64>,
+    pub mean_crack_core_axis_deg: Option<f64>,
+}
+
+/// objectivity.json.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectivityReport {
+    pub scene: String,
+    pub scene_file: String,
+    pub overrides: Vec<String>,
+    pub angles_deg: Vec<f64>,
+    pub random_offsets_per_angle: usize,
+    pub seed: u64,
+    /// Tensile damage at and above which a particle belongs to the crack path.
+    pub crack_damage: f64,
+    pub runs: usize,
+    pub completed: usize,
+    pub peak_force: Option<Spread>,
+    pub dissipated_energy: Option<Spread>,
+    pub per_angle: Vec<AngleSummary>,
+    pub rows: Vec<super::runner::RunRow>,
+    pub dir: PathBuf,
+}
+
+impl ObjectivityReport {
+    /// The one line the CLI prints.
+    pub fn spread_line(&self) -> String {
+        match &self.peak_force {
+            Some(s) => format!(
+                "peak force spread (max − min)/mean = {:.2}% over {} runs (min {:.4e} N at {}, max {:.4e} N at {})",
+                100.0 * s.spread,
+                s.runs,
+                s.min.value,
+                s.min.label,
+                s.max.value,
+                s.max.label
+            ),
+            None => format!(
+                "peak force spread (max − min)/mean: undefined, none of the {} runs completed",
+                self.runs
+            ),
+        }
+    }
+}
+
+/// The label of angle `a`, offset `k`: "a15_o0".
+pub fn label(angle_deg: f64, k: usize) -> String {
+    format!("a{angle_deg}_o{k}")
+}
+
+/// Run (or resume) the study and write objectivity.csv, objectivity.json and
+/// force_displacement_overlay.svg into the study folder.
+pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> {
+    if args.angles_deg.is_empty() {
+        bail!("--angles: give at least one angle in degrees, e.g. --angles 0,15,30,45");
+    }
+    if let Some(a) = args.angles_deg.iter().find(|a| !a.is_finite()) {
+        bail!("--angles: {a} is not an angle in degrees");
+    }
+    for (i, a) in args.angles_deg.iter().enumerate() {
+        if args.angles_deg[..i].contains(a) {
+            bail!("--angles: {a} appears twice");
+        }
+    }
+    if args.jobs == 0 {
+        bail!("--jobs 0: at least 1");
+    }
+    if !(args.crack_damage > 0.0 && args.crack_damage <= 1.0) {
+        bail!(
+            "--crack-damage {}: a tensile damage w_t with 0 < w_t <= 1",
+            args.crack_damage
+        );
+    }
+    let base = Scene::from_file(&args.scene, &args.overrides)?;
+    let d = &base.discretisation;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("output").join(format!("{}-objectivity", base.name())));
+    let mut variants = Vec::new();
+    for &a in &args.angles_deg {
+        for k in 0..=args.offsets {
+            let off = lattice_offset(args.seed, k, a, d.spacing, d.offset);
+            variants.push(Variant {
+                label: label(a, k),
+                overrides: vec![
+                    format!("discretisation.rotation_deg={a:?}"),
+                    format!("discretisation.offset=[{:?}, {:?}]", off[0], off[1]),
+                ],
+                tags: vec![a.to_string(), k.to_string(), args.seed.to_string()],
+            });
+        }
+    }
+    let threshold = args.crack_damage;
+    let metrics = move |o: &Outcome| crack_metrics(o, threshold);
+    let study = Study {
+        scene: args.scene.clone(),
+        base_overrides: args.overrides.clone(),
+        dir: dir.clone(),
+        csv_name: "objectivity.csv".into(),
+        tag_columns: vec!["angle_deg".into(), "offset".into(), "seed".into()],
+        metric_columns: CRACK_COLUMNS.iter().map(|s| s.to_string()).collect(),
+        metrics: &metrics,
+        inputs: serde_json::json!({
+            "study": "objectivity",
+            "scene_file": args.scene.display().to_string(),
+            "overrides": args.overrides,
+            "seed": args.seed,
+            "crack_damage": args.crack_damage,
+        }),
+        jobs: args.jobs,
+        progress: args.progress,
+    };
+    let results = study.run(&variants)?;
+
+    let title = format!(
+        "{}: force–displacement at every lattice rotation and offset",
+        base.name()
+    );
+    super::plots::overlay(
+        &title,
+        &results,
+        &|r| format!("θ = {}°, offset {}", r.row.tags[0], r.row.tags[1]),
+        &dir.join("force_displacement_overlay.svg"),
+    )?;
+    let metric = |r: &RunResult, name: &str| {
+        let i = CRACK_COLUMNS.iter().position(|c| *c == name).unwrap();
+        r.row.metrics[i]
+    };
+    let mean_of = |v: Vec<f64>| {
+        let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
+    let per_angle = args
+        .angles_deg
+        .iter()
+        .map(|&a| {
+            let rs: Vec<&RunResult> = results
+                .iter()
+                .filter(|r| r.row.completed() && r.row.rotation_deg == a)
+                .collect();
+            AngleSummary {
+                angle_deg: a,
+                runs: rs.len(),
+                mean_peak_force_n: mean_of(rs.iter().map(|r| r.row.peak_force_n).collect())
+                    .unwrap_or(f64::NAN),
+                mean_dissipated_energy_j: mean_of(
+                    rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
+                )
+                .unwrap_or(f64::NAN),
+                mean_crack_axis_deg: mean_axis_deg(
+                    &rs.iter()
+                        .map(|r| metric(r, "crack_axis_deg"))
+                        .filter(|a| a.is_finite())
+                        .collect::<Vec<_>>(),
+                ),
+                mean_crack_centroid_x_m: mean_of(
+                    rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
+                ),
+                mean_crack_core_axis_deg: mean_axis_deg(
+                    &rs.iter()
+                        .map(|r| metric(r, "crack_core_axis_deg"))
+                        .filter(|a| a.is_finite())
+                        .collect::<Vec<_>>(),
+                ),
+            }
+        })
+        .collect();
+    let report = ObjectivityReport {
+        scene: base.name().to_string(),
+        scene_file: args.scene.display().to_string(),
+        overrides: args.overrides.clone(),
+        angles_deg: args.angles_deg.clone(),
+        random_offsets_per_angle: args.offsets,
+        seed: args.seed,
+        crack_damage: args.crack_damage,
+        runs: results.len(),
+        completed: results.iter().filter(|r| r.row.completed()).count(),
+        peak_force: spread(&results, |r| r.row.peak_force_n),
+        dissipated_energy: spread(&results, |r| r.row.dissipated_energy_j),
+        per_angle,
+        rows: results.iter().map(|r| r.row.clone()).collect(),
+        dir: dir.clone(),
+    };
+    std::fs::write(
+        dir.join("objectivity.json"),
+        serde_json::to_string_pretty(&report)? + "\n",
+    )?;
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_lie_in_the_rotated_cell_and_depend_on_seed_and_index_only() {
+        let l0 = 0.01;
+        for k in 1..50 {
+            let (u, v) = offset_fraction(7, k);
+            assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
+            for angle in [0.0, 30.0, 45.0] {
+                let o = lattice_offset(7, k, angle, l0, [0.0, 0.0]);
+                // back to lattice coordinates: rotate by −θ, then solve with a1, a2
+                let (s, c) = (-angle.to_radians()).sin_cos();
+                let (x, y) = (c * o[0] - s * o[1], s * o[0] + c * o[1]);
+                let vv = y / (0.5 * 3f64.sqrt() * l0);
+                let uu = (x - 0.5 * l0 * vv) / l0;
+                assert!((uu - u).abs() < 1e-12 && (vv - v).abs() < 1e-12);
+            }
+        }
+        assert_eq!(lattice_offset(7, 0, 30.0, l0, [1e-3, 2e-3]), [1e-3, 2e-3]);
+        assert_ne!(offset_fraction(7, 1), offset_fraction(8, 1));
+        assert_ne!(offset_fraction(7, 1), offset_fraction(7, 2));
+        // the draws fill the cell: mean near 1/2
+        let mean_u = (1..=2000).map(|k| offset_fraction(1, k).0).sum::<f64>() / 2000.0;
+        assert!((mean_u - 0.5).abs() < 0.03, "{mean_u}");
+    }
+}
