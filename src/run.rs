@@ -239,13 +239,38 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
     })
 }
 
+/// A failed modal analysis, with the scene keys T1 depends on.
+fn modal_failure(model: &Model, e: modal::ModalError) -> RunError {
+    let text = e.to_string();
+    if text.contains("every particle is constrained") {
+        return RunError::Setup(format!("{text}: groups fix or load every component of every particle, so nothing is left to move; free some components (groups.*.fix, groups.*.load)"));
+    }
+    // A particle with one bond has no stiffness across it: a zero-frequency mode.
+    let p = &model.particles;
+    let single: Vec<usize> = (0..p.len()).filter(|&i| p.bond_count(i) == 1).collect();
+    let hanging = match single.first() {
+        Some(&i) => format!(
+            " {} particle(s) hang by a single bond and swing freely across it (e.g. particle {i} at {:?}): change discretisation.spacing, discretisation.rotation_deg or discretisation.offset, or the body's sharp corners.",
+            single.len(),
+            p.x0[i].as_slice()
+        ),
+        None => String::new(),
+    };
+    let m = &model.scene.material;
+    RunError::Setup(format!(
+        "{text}. T1 is the lowest mode of the lattice held by its supports (groups.*.fix, groups.*.load); it cannot be found when the supports leave a mechanism, or when material.nu = {} is so close to -1 or 0.5 that the stiffness is too ill-conditioned ({:?} plane).{hanging}",
+        m.nu, m.plane
+    ))
+}
+
 /// Discretise and assemble a scene, compute T1 and the time step.
 pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
     let mut model = prepare_model(scene)?;
     let d = &scene.discretisation;
     let m = &scene.material;
     let n = model.particles.len();
-    let fundamental = modal::fundamental(&model.mech, &model.particles.x0, &model.constrained)?;
+    let fundamental = modal::fundamental(&model.mech, &model.particles.x0, &model.constrained)
+        .map_err(|e| modal_failure(&model, e))?;
     let omega_i = material::particle_frequency(m.youngs_modulus(), m.nu, m.rho, d.spacing);
     let omega_struct = 2.0 * std::f64::consts::PI / fundamental.period;
     let mech = &mut model.mech;

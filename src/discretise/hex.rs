@@ -41,6 +41,21 @@ impl HexLattice {
     /// dropped.
     pub fn fill(&self, shape: &Shape2) -> Particles<2, 6> {
         let (a1, a2) = self.vectors();
+        // The same lattice with the offset reduced to within a cell of the origin, so that an
+        // offset of many cells does not cost the positions their precision.
+        let cells = nalgebra::Matrix2::from_columns(&[a1, a2])
+            .try_inverse()
+            .expect("lattice vectors are independent")
+            * self.offset;
+        let lattice = HexLattice {
+            offset: self.offset - a1 * cells.x.round() - a2 * cells.y.round(),
+            ..*self
+        };
+        lattice.fill_reduced(shape)
+    }
+
+    fn fill_reduced(&self, shape: &Shape2) -> Particles<2, 6> {
+        let (a1, a2) = self.vectors();
         let (lo, hi) = shape.bounding_box();
         let tol = 1e-9 * shape.size().max(self.spacing);
         // Lattice coordinates of the bounding box corners give the index range.

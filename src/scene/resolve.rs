@@ -150,6 +150,19 @@ impl Scene {
                 "must satisfy 0 < eps_ult < 0.1",
             ));
         }
+        // The plastic flow (3.44)–(3.47) adds Δλ = (f_y/E)·(ratio − 1) per step, explicitly;
+        // the shear stiffness E/(2(1+ν)) turns it into a stress change that overshoots the
+        // yield surface more and more as ν → −1, and the run diverges: measured unstable at
+        // ν = −0.9 (compression block, L0 = 20 mm) and −0.93, stable at −0.8 and −0.92
+        // (tests/proptest_scenes.rs, regression_auxetic_concrete_plasticity).
+        let nu = self.material.nu;
+        if c.plasticity && nu < -0.8 {
+            return Err(invalid(
+                "material.nu",
+                nu,
+                "at least -0.8 in a scene with concrete plasticity (the explicit plastic flow diverges as nu approaches -1); or set concrete.plasticity = false",
+            ));
+        }
         if ft >= fc {
             return Err(invalid(
                 "concrete.ft",

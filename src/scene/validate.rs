@@ -183,6 +183,18 @@ impl Scene {
             if let Some(l) = &g.load {
                 any_load = true;
                 finite(&format!("{key}.load.displacement"), l.delta())?;
+                // a displacement beyond the body's size is no loading of a specimen (and at
+                // 1e300 m the energies overflow)
+                if l.delta().abs() > self.body_size() {
+                    return Err(invalid(
+                        format!("{key}.load.displacement"),
+                        l.delta(),
+                        format!(
+                            "at most the body's smallest dimension ({:.4e} m) in magnitude",
+                            self.body_size()
+                        ),
+                    ));
+                }
                 if fixed.contains(&l.component.index()) {
                     return Err(invalid(
                         format!("{key}.load.component"),

@@ -147,8 +147,11 @@ impl<const D: usize> Lanczos<'_, D> {
         let (mut alpha, mut beta) = (Vec::new(), Vec::new());
         let mut beta_prev = 0.0;
         let mut last = f64::NAN;
-        let dims = D * n;
-        for step in 1..=self.max_steps.min(dims) {
+        // Not capped at the dimension D·n: without reorthogonalisation the recurrence goes on
+        // past it (ghost copies of converged values appear, the extreme one stays right), and
+        // a small, ill-conditioned model (a few dozen particles) needs more than D·n steps to
+        // meet the tolerance.
+        for step in 1..=self.max_steps {
             for i in 0..n {
                 u[i] = q[i] / sqrt_m[i];
             }

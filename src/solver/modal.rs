@@ -115,8 +115,12 @@ pub fn mechanisms<const D: usize>(
             .map(|x| (x - centre).norm())
             .fold(0.0, f64::max)
             .max(1e-300);
-        let c = DMatrix::from_fn(rows.len(), m, |r, k| {
-            let (i, d) = rows[r];
+        // At least m rows (zero rows add no constraint), so that the SVD gives all m right
+        // singular vectors even when fewer components than rigid modes are held.
+        let c = DMatrix::from_fn(rows.len().max(m), m, |r, k| {
+            let Some(&(i, d)) = rows.get(r) else {
+                return 0.0;
+            };
             let w = if k >= D { 1.0 / scale } else { 1.0 };
             rigid[k][i][d] * w
         });
