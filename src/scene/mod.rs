@@ -482,13 +482,13 @@ impl Default for SolverSpec {
 }
 
 fn default_increments() -> usize {
-    100
+    200
 }
 fn default_tolerance() -> f64 {
-    1e-3
+    1e-4
 }
 fn default_max_iterations() -> usize {
-    20_000
+    500
 }
 
 fn default_safety() -> f64 {
