@@ -95,7 +95,8 @@ fn relaxation_does_not_depend_on_the_thread_count() {
 
 /// The block of tests/concrete.rs (150 × 100 mm, L0 = 10 mm, Table 1 concrete), pulled by
 /// 1.5·COD_c under relaxation with the default increments and tolerance: the peak within 5%
-/// of f't·A, as the explicit validation test asserts.
+/// of f't·A and the dissipated energy within 10% of G_f·A, as the explicit validation test
+/// asserts (tests/concrete.rs).
 #[test]
 fn relaxed_tension_block_reaches_ft() {
     let text = r#"
@@ -154,6 +155,15 @@ vtk = false
         sm.peak_force_n
     );
     assert!(sm.max_damage.unwrap() >= 0.99, "the block did not crack");
+    // The 100 mm block separates without snap-back, so the relaxation follows the softening
+    // branch and the energy booked as dissipated (external work less elastic, kinetic and
+    // damper energy, with the predictor's work booked exactly) is G_f per unit crack area,
+    // within the 10% of VALIDATION.md §B. Measured 1.035 G_f·A.
+    assert!(
+        (sm.dissipated_energy_j / gfa - 1.0).abs() <= 0.10,
+        "dissipated {} J against G_f·A = {gfa} J",
+        sm.dissipated_energy_j
+    );
 }
 
 fn error_of(overrides: &[&str]) -> String {
