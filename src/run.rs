@@ -6,12 +6,12 @@ use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
 use crate::material;
 use crate::model::micro_modulus::{self, MicroModuli};
 use crate::model::stress::StressSum;
-use crate::scene::{Scene, SceneError};
+use crate::scene::{Scene, SceneError, SolverMethod};
 use crate::solver::concrete::{self, Concrete, ParticleDamage};
 use crate::solver::loading::Prescribed;
 use crate::solver::mechanics::Mechanics;
 use crate::solver::time_step::{stable_step, StableStep};
-use crate::solver::{modal, Integration, Probe, Record, Simulation};
+use crate::solver::{modal, relaxation, Integration, Probe, Record, Simulation};
 use nalgebra::{Matrix2, Vector2};
 use serde::Serialize;
 use std::time::Instant;
@@ -362,6 +362,20 @@ pub struct Summary {
     pub fundamental_period_s: f64,
     pub t_end_s: f64,
     pub wall_time_s: f64,
+    /// Wall time from the start of the run to the record of the peak force.
+    pub wall_time_to_peak_s: f64,
+    /// Step of the peak record.
+    pub peak_step: usize,
+    pub solver_method: SolverMethod,
+    /// Relaxation: kernel steps of all increments.
+    pub iterations: Option<usize>,
+    /// Relaxation: load increments.
+    pub increments: Option<usize>,
+    /// Relaxation: increments that stopped at solver.max_iterations.
+    pub unconverged_increments: Option<usize>,
+    /// Relaxation: largest out-of-balance force norm / reaction norm at the end of an
+    /// increment.
+    pub max_final_residual: Option<f64>,
     pub threads: usize,
     pub probe_group: Option<String>,
     #[serde(rename = "peak_force_N")]
@@ -499,50 +513,47 @@ pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
 
 fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
     let start = Instant::now();
+    let method = p.model.scene.solver.method;
+    if method == SolverMethod::Relaxation {
+        // Dampers off; the step of the undamped model (see solver::relaxation).
+        p.stable = relaxation::undamped(&mut p.model.mech, &p.model.particles.x0);
+        p.dt = p
+            .model
+            .scene
+            .solver
+            .dt
+            .unwrap_or(p.model.scene.solver.safety * p.stable.dt_stable);
+    }
     let mut sim = build_simulation(&mut p);
-    let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
-    let bar = if opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7 {
-        let b = indicatif::ProgressBar::new(p.steps as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} {wide_bar} {pos}/{len} steps  {elapsed_precise} ETA {eta}",
-            )
-            .unwrap(),
-        );
-        Some(b)
-    } else {
-        None
-    };
     let empty_probe = Probe {
         members: vec![],
         component: 1,
         amplitude: 0.0,
     };
     let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
-    let mut records = Vec::with_capacity(p.model.scene.output.records + 1);
-    let mut failure = None;
-    for n in 0..p.steps {
-        let want = n % every == 0 || n + 1 == p.steps;
-        let rec = sim.advance(if want { Some(probe) } else { None });
-        if let Some(r) = rec {
-            records.push(r);
+    let (records, wall_s, failure, report) = match method {
+        SolverMethod::Explicit => {
+            let (records, wall_s, failure) = run_explicit(&mut sim, &p, probe, opts, start);
+            (records, wall_s, failure, SolverReport::default())
         }
-        if want || n % 64 == 0 {
-            let u = rec.map(|r| r.internal_j);
-            if let Err(e) = sim.check_stability(u) {
-                failure = Some(e);
-                break;
-            }
+        SolverMethod::Relaxation => {
+            let s = &p.model.scene.solver;
+            let settings = relaxation::Settings {
+                increments: s.increments,
+                tolerance: s.tolerance,
+                max_iterations: s.max_iterations,
+                ramp: p.model.scene.loading.ramp,
+            };
+            let r = relaxation::relax(&mut sim, probe, &settings, start);
+            let report = SolverReport {
+                iterations: Some(r.iterations),
+                increments: Some(s.increments),
+                unconverged_increments: Some(r.unconverged_increments),
+                max_final_residual: Some(r.max_final_residual),
+            };
+            (r.records, r.wall_s, r.failure, report)
         }
-        if let Some(b) = &bar {
-            if n % 256 == 0 {
-                b.set_position(n as u64);
-            }
-        }
-    }
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    };
     let wall = start.elapsed().as_secs_f64();
     let x = sim.state.x.clone();
     let displacement: Vec<Vector2<f64>> = x
@@ -560,7 +571,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
             None,
         ),
     };
-    let summary = summarise(
+    let mut summary = summarise(
         &p,
         sim.kernel(),
         &records,
@@ -569,6 +580,16 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
         failure.as_ref().map(|e| e.to_string()),
         damage.as_deref(),
     );
+    summary.solver_method = method;
+    summary.iterations = report.iterations;
+    summary.increments = report.increments;
+    summary.unconverged_increments = report.unconverged_increments;
+    summary.max_final_residual = report.max_final_residual;
+    summary.wall_time_to_peak_s = records
+        .iter()
+        .position(|r| r.step == summary.peak_step)
+        .and_then(|i| wall_s.get(i).copied())
+        .unwrap_or(wall);
     let outcome = Outcome {
         summary,
         records,
@@ -580,6 +601,66 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
         scene: p.model.scene.clone(),
     };
     Ok(outcome)
+}
+
+/// What the relaxation solver adds to the summary (`None` for the explicit one).
+#[derive(Clone, Copy, Debug, Default)]
+struct SolverReport {
+    iterations: Option<usize>,
+    increments: Option<usize>,
+    unconverged_increments: Option<usize>,
+    max_final_residual: Option<f64>,
+}
+
+/// The explicit run to t_end with probe records (and the wall time at each), stopping at an
+/// instability.
+fn run_explicit(
+    sim: &mut Simulation<2, 6>,
+    p: &Prepared,
+    probe: &Probe,
+    opts: &RunOptions,
+    start: Instant,
+) -> (Vec<Record>, Vec<f64>, Option<crate::solver::Unstable>) {
+    let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
+    let bar = if opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7 {
+        let b = indicatif::ProgressBar::new(p.steps as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} {wide_bar} {pos}/{len} steps  {elapsed_precise} ETA {eta}",
+            )
+            .unwrap(),
+        );
+        Some(b)
+    } else {
+        None
+    };
+    let mut records = Vec::with_capacity(p.model.scene.output.records + 1);
+    let mut wall_s = Vec::with_capacity(p.model.scene.output.records + 1);
+    let mut failure = None;
+    for n in 0..p.steps {
+        let want = n % every == 0 || n + 1 == p.steps;
+        let rec = sim.advance(if want { Some(probe) } else { None });
+        if let Some(r) = rec {
+            records.push(r);
+            wall_s.push(start.elapsed().as_secs_f64());
+        }
+        if want || n % 64 == 0 {
+            let u = rec.map(|r| r.internal_j);
+            if let Err(e) = sim.check_stability(u) {
+                failure = Some(e);
+                break;
+            }
+        }
+        if let Some(b) = &bar {
+            if n % 256 == 0 {
+                b.set_position(n as u64);
+            }
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    (records, wall_s, failure)
 }
 
 fn summarise(
@@ -643,6 +724,13 @@ fn summarise(
         fundamental_period_s: p.fundamental.period,
         t_end_s: p.t_end,
         wall_time_s: wall,
+        wall_time_to_peak_s: wall,
+        peak_step: peak.map(|r| r.step).unwrap_or(0),
+        solver_method: SolverMethod::Explicit,
+        iterations: None,
+        increments: None,
+        unconverged_increments: None,
+        max_final_residual: None,
         threads,
         probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),
         peak_force_n: peak.map(|r| r.force_n * sign).unwrap_or(0.0),

@@ -440,6 +440,30 @@ pub struct SolverSpec {
     /// Worker threads (default: all cores).
     #[serde(default)]
     pub threads: Option<usize>,
+    /// Damped explicit dynamics or adaptive dynamic relaxation (`solver::relaxation`).
+    #[serde(default)]
+    pub method: SolverMethod,
+    /// Relaxation: load increments over the ramp.
+    #[serde(default = "default_increments")]
+    pub increments: usize,
+    /// Relaxation: an increment has converged when the out-of-balance force norm on the free
+    /// components is at most `tolerance` × the largest reaction norm so far.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Relaxation: iteration limit of one increment.
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: usize,
+}
+
+/// How a run reaches the loaded state.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverMethod {
+    /// Damped explicit central differences over the loading time (MODEL.md §4–5).
+    #[default]
+    Explicit,
+    /// Adaptive dynamic relaxation (Kilic & Madenci 2010) in load increments.
+    Relaxation,
 }
 
 impl Default for SolverSpec {
@@ -449,8 +473,22 @@ impl Default for SolverSpec {
             dt: None,
             force_lag: default_lag(),
             threads: None,
+            method: SolverMethod::default(),
+            increments: default_increments(),
+            tolerance: default_tolerance(),
+            max_iterations: default_max_iterations(),
         }
     }
+}
+
+fn default_increments() -> usize {
+    200
+}
+fn default_tolerance() -> f64 {
+    1e-4
+}
+fn default_max_iterations() -> usize {
+    500
 }
 
 fn default_safety() -> f64 {

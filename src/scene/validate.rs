@@ -233,7 +233,7 @@ impl Scene {
             }
             (None, Some(s)) => positive("loading.end_s", s)?,
             (None, None) => {
-                if any_load {
+                if any_load && self.solver.method == SolverMethod::Explicit {
                     return Err(invalid(
                         "loading.end_periods",
                         "(missing)",
@@ -268,6 +268,7 @@ impl Scene {
                 return Err(invalid("solver.threads", t, "an integer from 1 to 1024"));
             }
         }
+        self.validate_relaxation()?;
 
         let o = &self.output;
         if o.records < 2 || o.records > 1_000_000 {
@@ -432,5 +433,41 @@ impl Scene {
                 notch_width: *notch_width,
             },
         }
+    }
+}
+
+impl Scene {
+    /// The keys of `solver.method = "relaxation"`.
+    fn validate_relaxation(&self) -> Result<(), SceneError> {
+        let s = &self.solver;
+        if s.increments == 0 || s.increments > 1_000_000 {
+            return Err(invalid(
+                "solver.increments",
+                s.increments,
+                "an integer from 1 to 1000000 (load increments of the relaxation solver)",
+            ));
+        }
+        if !(s.tolerance.is_finite() && s.tolerance > 0.0 && s.tolerance < 1.0) {
+            return Err(invalid(
+                "solver.tolerance",
+                s.tolerance,
+                "must satisfy 0 < tolerance < 1 (out-of-balance force norm relative to the largest reaction norm)",
+            ));
+        }
+        if s.max_iterations == 0 || s.max_iterations > 100_000_000 {
+            return Err(invalid(
+                "solver.max_iterations",
+                s.max_iterations,
+                "an integer from 1 to 100000000 (iterations of one load increment)",
+            ));
+        }
+        if s.method == SolverMethod::Relaxation && s.force_lag == ForceLag::Previous {
+            return Err(invalid(
+                "solver.force_lag",
+                "\"previous\"",
+                "\"current\" with solver.method = \"relaxation\" (the relaxation iterates on the forces at the current positions)",
+            ));
+        }
+        Ok(())
     }
 }

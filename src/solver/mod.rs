@@ -8,6 +8,7 @@ pub mod linear;
 pub mod loading;
 pub mod mechanics;
 pub mod modal;
+pub mod relaxation;
 pub mod time_step;
 
 use kernel::State;
@@ -102,6 +103,16 @@ pub struct Simulation<const D: usize, const K: usize> {
     bond_dampers: bool,
     /// Damage and plasticity; `None` runs the elastic kernel.
     pub inelastic: Option<Box<dyn concrete::Inelastic<D, K>>>,
+    /// Load factor held instead of the time ramp (dynamic relaxation), see [`Self::hold_load`].
+    held: Option<HeldLoad>,
+}
+
+/// A load factor held from a given step on (the factor `before` applies to earlier steps).
+#[derive(Clone, Copy, Debug)]
+struct HeldLoad {
+    from_step: usize,
+    before: f64,
+    after: f64,
 }
 
 impl<const D: usize, const K: usize> Simulation<D, K> {
@@ -125,6 +136,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             energy_floor: 0.0,
             bond_dampers,
             inelastic: None,
+            held: None,
         };
         // The elastic energy at rest is not zero to round-off (positions far from the origin
         // or offset by many cells, rotated lattices): it is initial energy, part of E0.
@@ -168,7 +180,34 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
 
     /// Fraction of Δmax applied at time t.
     fn ramp_at(&self, t: f64) -> f64 {
+        if let Some(h) = self.held {
+            let step = (t / self.integration.dt).round();
+            return if step >= h.from_step as f64 {
+                h.after
+            } else {
+                h.before
+            };
+        }
         ramp_fraction(self.integration.ramp, t, self.integration.t_ramp)
+    }
+
+    /// From the next step on, hold the prescribed displacements at `factor` × Δmax instead
+    /// of following the time ramp (load increments of dynamic relaxation). The positions the
+    /// current step computes, x^{n+1}, carry the new factor; the work of the jump is booked
+    /// by the central rule like any other motion of the supports.
+    pub fn hold_load(&mut self, factor: f64) {
+        let before = self.ramp_at(self.time());
+        self.held = Some(HeldLoad {
+            from_step: self.step + 1,
+            before,
+            after: factor,
+        });
+    }
+
+    /// Book work done on the specimen outside the kernel (the displacement predictor of
+    /// dynamic relaxation moves free particles between steps).
+    pub fn add_external_work(&mut self, work: f64) {
+        self.external_work += work;
     }
 
     /// Start from a given displacement field and velocity (free-vibration tests).
