@@ -143,14 +143,29 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             println!("fundamental T1   {:.6e} s", p.fundamental.period);
             println!("stable dt        {:.6e} s", p.stable.dt_stable);
             println!("time step dt     {:.6e} s", p.dt);
-            println!("t_end            {:.6e} s", p.t_end);
-            println!("steps            {}", p.steps);
-            println!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-            println!(
-                "run time (est.)  {:.1} s on {} threads",
-                per_step * p.steps as f64,
-                rayon::current_num_threads()
-            );
+            let threads = rayon::current_num_threads();
+            let solver = &sc.solver;
+            if solver.method == sppm::scene::SolverMethod::Relaxation {
+                // the iterations per increment are known only once it has converged
+                let most = solver.increments * solver.max_iterations;
+                println!(
+                    "solver           relaxation: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
+                    solver.increments, solver.max_iterations, solver.tolerance
+                );
+                println!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+                println!(
+                    "run time (est.)  at most {:.1} s on {threads} threads ({most} iterations); elastic increments converge in 1–10",
+                    per_step * most as f64
+                );
+            } else {
+                println!("t_end            {:.6e} s", p.t_end);
+                println!("steps            {}", p.steps);
+                println!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+                println!(
+                    "run time (est.)  {:.1} s on {threads} threads",
+                    per_step * p.steps as f64
+                );
+            }
             println!(
                 "surface corr.    {} of {} boundary particles",
                 p.model.surface.corrected, p.model.surface.boundary_particles

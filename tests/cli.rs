@@ -125,6 +125,19 @@ fn check_reports_size_step_and_estimates() {
     ] {
         assert!(text.contains(word), "check output lacks {word}:\n{text}");
     }
+    // a relaxation scene has no step count in advance: check gives the increments and an
+    // upper bound of the iterations (200 × 500 by default)
+    let o = sppm(&[
+        "check",
+        "lattices/elastic_plate.toml",
+        "--set",
+        "solver.method=relaxation",
+    ]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("relaxation: 200 increments of at most 500 iterations"));
+    assert!(text.contains("(100000 iterations)"), "{text}");
+    assert!(!text.contains("\nsteps "), "{text}");
 }
 
 #[test]
