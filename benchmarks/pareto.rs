@@ -14,6 +14,7 @@
 
 use anyhow::{bail, Context};
 use plotters::prelude::*;
+use sppm::output::plots::err;
 use sppm::study::pareto::{nearness, pareto_front, reference, SweepRun};
 use sppm::{RunOptions, Scene};
 use std::collections::HashSet;
@@ -272,7 +273,6 @@ fn plot(
     front: &[(f64, f64)],
     default: usize,
 ) -> anyhow::Result<()> {
-    let e = |e: &dyn std::fmt::Display| anyhow::anyhow!("plotting failed: {e}");
     let floor = 1e-4; // errors below 0.01% are drawn at 0.01%
     let y = |v: f64| v.max(floor);
     let (t0, t1) = pts
@@ -280,7 +280,7 @@ fn plot(
         .fold((f64::INFINITY, 0f64), |(a, b), p| (a.min(p.0), b.max(p.0)));
     let e1 = pts.iter().map(|p| y(p.1)).fold(floor, f64::max);
     let root = SVGBackend::new(path, (900, 620)).into_drawing_area();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
+    root.fill(&WHITE).map_err(err)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!("{name}: peak-load error against wall time"),
@@ -293,14 +293,14 @@ fn plot(
             ((t0 * 0.8)..(t1 * 1.25)).log_scale(),
             (floor * 0.8..e1 * 1.5).log_scale(),
         )
-        .map_err(|x| e(&x))?;
+        .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc("wall time (s)")
         .y_desc("|peak − reference| / reference")
         .y_label_formatter(&|v| format!("{:.2}%", v * 100.0))
         .draw()
-        .map_err(|x| e(&x))?;
+        .map_err(err)?;
     let params = [
         "spacing",
         "end_periods",
@@ -319,7 +319,7 @@ fn plot(
             .collect();
         chart
             .draw_series(series.iter().map(|q| Circle::new(*q, 5, c.filled())))
-            .map_err(|x| e(&x))?
+            .map_err(err)?
             .label(*p)
             .legend(move |(x, yy)| Circle::new((x + 10, yy), 5, c.filled()));
     }
@@ -336,13 +336,13 @@ fn plot(
     }
     chart
         .draw_series(LineSeries::new(stairs, BLACK.stroke_width(2)))
-        .map_err(|x| e(&x))?
+        .map_err(err)?
         .label("Pareto front")
         .legend(|(x, yy)| PathElement::new(vec![(x, yy), (x + 20, yy)], BLACK.stroke_width(2)));
     let dp = (pts[default].0, y(pts[default].1));
     chart
         .draw_series(std::iter::once(Cross::new(dp, 9, RED.stroke_width(3))))
-        .map_err(|x| e(&x))?
+        .map_err(err)?
         .label("shipped default")
         .legend(|(x, yy)| Cross::new((x + 10, yy), 6, RED.stroke_width(3)));
     chart
@@ -351,7 +351,7 @@ fn plot(
         .background_style(WHITE.mix(0.85))
         .position(SeriesLabelPosition::LowerLeft)
         .draw()
-        .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))?;
+        .map_err(err)?;
+    root.present().map_err(err)?;
     Ok(())
 }

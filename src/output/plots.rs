@@ -8,8 +8,15 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
-fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
+/// A plotting error as an anyhow error (plotters' errors are generic over the backend).
+pub fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow::anyhow!("plotting failed: {e}")
+}
+
+/// The range lo..hi widened by 5% of its length on each side (at least 5e-14).
+pub fn padded(lo: f64, hi: f64) -> std::ops::Range<f64> {
+    let d = (hi - lo).abs().max(1e-12) * 0.05;
+    (lo - d)..(hi + d)
 }
 
 /// Viridis colour map, t in [0, 1].
@@ -56,12 +63,7 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
         y0 = y0.min(y);
         y1 = y1.max(y);
     }
-    let pad = |a: f64, b: f64| {
-        let d = (b - a).abs().max(1e-12) * 0.05;
-        (a - d, b + d)
-    };
-    let (x0, x1) = pad(x0, x1);
-    let (y0, y1) = pad(y0, y1);
+
     let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
     let group = o.summary.probe_group.clone().unwrap_or_else(|| "-".into());
@@ -73,7 +75,7 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
         .margin(15)
         .x_label_area_size(50)
         .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, y0..y1)
+        .build_cartesian_2d(padded(x0, x1), padded(y0, y1))
         .map_err(err)?;
     let turned = if sign < 0.0 { " (sign turned)" } else { "" };
     chart

@@ -2,17 +2,9 @@
 //! and dissipated energy against the lattice spacing with their extrapolated references.
 
 use super::runner::RunResult;
+use crate::output::plots::{err, padded};
 use plotters::prelude::*;
 use std::path::Path;
-
-fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
-    anyhow::anyhow!("plotting failed: {e}")
-}
-
-fn padded(lo: f64, hi: f64) -> std::ops::Range<f64> {
-    let d = (hi - lo).abs().max(1e-12) * 0.05;
-    (lo - d)..(hi + d)
-}
 
 /// Every run's force–displacement curve (kN against mm) in one plot, one colour per run,
 /// labelled by `legend(result)`. Curves pushed in the negative direction are plotted with
