@@ -238,11 +238,27 @@ fn update_state<const K: usize, const FULL: bool>(
     sps_trial: &mut [f64; K],
     cache: &mut [SlotCache; K],
 ) -> f64 {
-    let (sl, b_theta) = slots::<K, FULL>(m, c, x, i);
+    // One pass over the slots: the cache for pass 2, bθ_i, and the stretches for the strain.
+    let mut st = [0.0; K];
+    let mut se = [0.0; K];
+    let mut dse = [0.0; K];
+    let mut used = [false; K];
+    let mut theta = 0.0;
+    let mut theta_e = 0.0;
+    // The damaged elastic stretches equal the total ones (undamaged bonds, no plastic
+    // stretch): one strain fit serves both.
+    let mut same = true;
     for k in 0..K {
-        cache[k] = match sl[k] {
+        cache[k] = match slot::<K, FULL>(m, c, x, i, k) {
             Some(s) => {
                 let j = m.neighbours[i][k] as usize;
+                st[k] = s.st;
+                se[k] = s.se;
+                dse[k] = s.d * s.se;
+                used[k] = true;
+                theta += s.sd * s.se;
+                theta_e += s.se;
+                same &= dse[k] == st[k];
                 SlotCache {
                     e: s.e,
                     d_a_se: s.d * ((m.a[i] + m.a[j]) * s.se),
@@ -253,6 +269,7 @@ fn update_state<const K: usize, const FULL: bool>(
             None => SlotCache::default(),
         };
     }
+    let b_theta = m.b[i] * theta;
     let law = &c.law;
     let mut p = c.committed[i];
     if FULL {
@@ -261,24 +278,6 @@ fn update_state<const K: usize, const FULL: bool>(
     if p.wt >= 1.0 && (p.wc >= 1.0 || !FULL) {
         *trial = p;
         return b_theta;
-    }
-    let mut st = [0.0; K];
-    let mut se = [0.0; K];
-    let mut dse = [0.0; K];
-    let mut used = [false; K];
-    let mut theta_e = 0.0;
-    // The damaged elastic stretches equal the total ones (undamaged bonds, no plastic
-    // stretch): one strain fit serves both.
-    let mut same = true;
-    for k in 0..K {
-        if let Some(s) = sl[k] {
-            st[k] = s.st;
-            se[k] = s.se;
-            dse[k] = s.d * s.se;
-            used[k] = true;
-            theta_e += s.se;
-            same &= dse[k] == st[k];
-        }
     }
     // Strains (§7): total for the damage law and ε_eff; the criteria stress from the damaged
     // elastic stretches.
