@@ -389,7 +389,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                             .unwrap_or(std::cmp::Ordering::Equal)
                     })
                     .unwrap_or(0);
-                (i, format!("kinetic + elastic energy {total:.3e} J exceeds 10× the energy put in ({reference:.3e} J); the fastest particle is"))
+                (i, format!("kinetic + elastic energy {total:.3e} J exceeds 10× the energy put in ({reference:.3e} J), fastest"))
             }
         };
         Err(Unstable {
