@@ -11,7 +11,7 @@ use crate::solver::concrete::{self, Concrete, ParticleDamage};
 use crate::solver::loading::Prescribed;
 use crate::solver::mechanics::Mechanics;
 use crate::solver::time_step::{stable_step, StableStep};
-use crate::solver::{modal, relaxation, Integration, Probe, Record, Simulation};
+use crate::solver::{modal, relaxation, Integration, PeakStop, Probe, Record, Simulation};
 use nalgebra::{Matrix2, Vector2};
 use serde::Serialize;
 use std::time::Instant;
@@ -376,6 +376,8 @@ pub struct Summary {
     /// Relaxation: largest out-of-balance force norm / reaction norm at the end of an
     /// increment.
     pub max_final_residual: Option<f64>,
+    /// The run stopped after its peak (`loading.stop_after_peak`), before t_end.
+    pub stopped_after_peak: bool,
     pub threads: usize,
     pub probe_group: Option<String>,
     #[serde(rename = "peak_force_N")]
@@ -533,8 +535,13 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
     let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
     let (records, wall_s, failure, report) = match method {
         SolverMethod::Explicit => {
-            let (records, wall_s, failure) = run_explicit(&mut sim, &p, probe, opts, start);
-            (records, wall_s, failure, SolverReport::default())
+            let (records, wall_s, failure, stopped) =
+                run_explicit(&mut sim, &p, probe, opts, start);
+            let report = SolverReport {
+                stopped_after_peak: stopped,
+                ..Default::default()
+            };
+            (records, wall_s, failure, report)
         }
         SolverMethod::Relaxation => {
             let s = &p.model.scene.solver;
@@ -543,6 +550,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
                 tolerance: s.tolerance,
                 max_iterations: s.max_iterations,
                 ramp: p.model.scene.loading.ramp,
+                stop_after_peak: p.model.scene.loading.stop_after_peak,
             };
             let r = relaxation::relax(&mut sim, probe, &settings, start);
             let report = SolverReport {
@@ -550,6 +558,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
                 increments: Some(s.increments),
                 unconverged_increments: Some(r.unconverged_increments),
                 max_final_residual: Some(r.max_final_residual),
+                stopped_after_peak: r.stopped_after_peak,
             };
             (r.records, r.wall_s, r.failure, report)
         }
@@ -585,6 +594,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
     summary.increments = report.increments;
     summary.unconverged_increments = report.unconverged_increments;
     summary.max_final_residual = report.max_final_residual;
+    summary.stopped_after_peak = report.stopped_after_peak;
     summary.wall_time_to_peak_s = records
         .iter()
         .position(|r| r.step == summary.peak_step)
@@ -610,17 +620,20 @@ struct SolverReport {
     increments: Option<usize>,
     unconverged_increments: Option<usize>,
     max_final_residual: Option<f64>,
+    stopped_after_peak: bool,
 }
 
 /// The explicit run to t_end with probe records (and the wall time at each), stopping at an
-/// instability.
+/// instability, or after the peak with `loading.stop_after_peak` (then `true`).
 fn run_explicit(
     sim: &mut Simulation<2, 6>,
     p: &Prepared,
     probe: &Probe,
     opts: &RunOptions,
     start: Instant,
-) -> (Vec<Record>, Vec<f64>, Option<crate::solver::Unstable>) {
+) -> (Vec<Record>, Vec<f64>, Option<crate::solver::Unstable>, bool) {
+    let mut stop = PeakStop::new(p.model.scene.loading.stop_after_peak, probe);
+    let mut stopped = false;
     let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
     let bar = if opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7 {
         let b = indicatif::ProgressBar::new(p.steps as u64);
@@ -651,6 +664,10 @@ fn run_explicit(
                 break;
             }
         }
+        if rec.is_some_and(|r| stop.reached(&r, sim)) {
+            stopped = true;
+            break;
+        }
         if let Some(b) = &bar {
             if n % 256 == 0 {
                 b.set_position(n as u64);
@@ -660,7 +677,7 @@ fn run_explicit(
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    (records, wall_s, failure)
+    (records, wall_s, failure, stopped)
 }
 
 fn summarise(
@@ -731,6 +748,7 @@ fn summarise(
         increments: None,
         unconverged_increments: None,
         max_final_residual: None,
+        stopped_after_peak: false,
         threads,
         probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),
         peak_force_n: peak.map(|r| r.force_n * sign).unwrap_or(0.0),

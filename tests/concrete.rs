@@ -329,3 +329,40 @@ fn tension_kernel_matches_the_full_kernel_bit_for_bit() {
         sppm::solver::KernelSet::Full
     );
 }
+
+/// `loading.stop_after_peak` ends the run once the force has fallen below the fraction of the
+/// peak and a particle has failed: the records up to there are the full run's, so the peak is
+/// the same bit for bit, in fewer steps. An elastic scene has no peak to pass: refused.
+#[test]
+fn stop_after_peak_keeps_the_peak_and_saves_the_tail() {
+    let opts = RunOptions {
+        threads: Some(2),
+        ..Default::default()
+    };
+    let full = run(&block(0.1, 0.01, &["loading.end_periods=20"]), &opts).unwrap();
+    let stop = run(
+        &block(
+            0.1,
+            0.01,
+            &["loading.end_periods=20", "loading.stop_after_peak=0.5"],
+        ),
+        &opts,
+    )
+    .unwrap();
+    let (f, s) = (&full.summary, &stop.summary);
+    assert!(!f.stopped_after_peak && s.stopped_after_peak);
+    assert_eq!(f.peak_force_n.to_bits(), s.peak_force_n.to_bits());
+    assert_eq!(f.displacement_at_peak_m, s.displacement_at_peak_m);
+    assert!(s.steps < f.steps, "{} of {} steps", s.steps, f.steps);
+    assert!(s.final_force_n < 0.5 * s.peak_force_n);
+    assert!(stop.damage.unwrap().iter().any(|p| p.wt >= 0.99));
+    // the records before the stop are the full run's
+    for (a, b) in stop.records.iter().zip(&full.records) {
+        assert_eq!(a.force_n.to_bits(), b.force_n.to_bits());
+    }
+    let elastic = common::plate_toml(0.1, 0.2, 0.01, 0.0, "stress", false, 0.2);
+    let e = Scene::from_toml_str(&elastic, &["loading.stop_after_peak=0.5".into()]).unwrap_err();
+    assert!(e.to_string().contains("loading.stop_after_peak"), "{e}");
+    let e = Scene::from_toml_str(&elastic, &["loading.stop_after_peak=1.5".into()]).unwrap_err();
+    assert!(e.to_string().contains("loading.stop_after_peak"), "{e}");
+}

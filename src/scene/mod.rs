@@ -358,6 +358,10 @@ pub struct LoadingSpec {
     /// t_end in seconds (instead of end_periods).
     #[serde(default)]
     pub end_s: Option<f64>,
+    /// Stop the run once, after the peak, the probe force has fallen below this fraction of
+    /// the peak and a particle has failed (w_t or w_c ≥ 0.99); scenes with `[concrete]`.
+    #[serde(default)]
+    pub stop_after_peak: Option<f64>,
 }
 
 impl Default for LoadingSpec {
@@ -367,6 +371,7 @@ impl Default for LoadingSpec {
             ramp_fraction: default_ramp_fraction(),
             end_periods: None,
             end_s: None,
+            stop_after_peak: None,
         }
     }
 }

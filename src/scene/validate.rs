@@ -243,6 +243,23 @@ impl Scene {
             }
         }
 
+        if let Some(f) = l.stop_after_peak {
+            if !(f > 0.0 && f < 1.0) {
+                return Err(invalid(
+                    "loading.stop_after_peak",
+                    f,
+                    "a fraction of the peak force, 0 < stop_after_peak < 1",
+                ));
+            }
+            if self.concrete.is_none() {
+                return Err(invalid(
+                    "loading.stop_after_peak",
+                    f,
+                    "a scene with [concrete] (an elastic specimen has no peak to pass)",
+                ));
+            }
+        }
+
         for (k, v) in [
             ("damping.internal", self.damping.internal),
             ("damping.external", self.damping.external),

@@ -74,6 +74,43 @@ pub struct Probe {
     pub amplitude: f64,
 }
 
+/// Stops a run once it has passed its peak (`loading.stop_after_peak`): the probe force,
+/// taken along the loading direction, has fallen below `fraction` × its largest value and a
+/// particle has failed. The failed particle keeps the early ramp, where the force is near
+/// zero and dynamic ripples can dip below any fraction of it, from stopping the run. Records
+/// up to the stop are those of the full run, so its peak is the same bit for bit.
+#[derive(Clone, Copy, Debug)]
+pub struct PeakStop {
+    fraction: Option<f64>,
+    /// +1 or −1: the loading direction of the probe.
+    sign: f64,
+    peak: f64,
+}
+
+impl PeakStop {
+    pub fn new(fraction: Option<f64>, probe: &Probe) -> Self {
+        PeakStop {
+            fraction,
+            sign: if probe.amplitude < 0.0 { -1.0 } else { 1.0 },
+            peak: 0.0,
+        }
+    }
+
+    /// Whether the run may stop after this record.
+    pub fn reached<const D: usize, const K: usize>(
+        &mut self,
+        rec: &Record,
+        sim: &Simulation<D, K>,
+    ) -> bool {
+        let Some(fraction) = self.fraction else {
+            return false;
+        };
+        let f = self.sign * rec.force_n;
+        self.peak = self.peak.max(f);
+        self.peak > 0.0 && f < fraction * self.peak && sim.has_failed_particle()
+    }
+}
+
 /// A run that went unstable.
 #[derive(Debug, thiserror::Error)]
 #[error("the run went unstable at step {step} (t = {time:.6e} s): {what} at particle {particle} (reference position {position}); reduce solver.safety or solver.dt, or check the material")]
@@ -164,6 +201,16 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         }
         let s = 1000.0 * f64::EPSILON * reach;
         0.25 * s * s * sum
+    }
+
+    /// Whether some particle has failed (w_t or w_c ≥ 0.99); never for the elastic kernel.
+    pub fn has_failed_particle(&self) -> bool {
+        self.inelastic.as_ref().is_some_and(|m| {
+            m.concrete()
+                .committed
+                .iter()
+                .any(|p| p.wt >= 0.99 || p.wc >= 0.99)
+        })
     }
 
     /// The step kernel this simulation runs.

@@ -42,7 +42,7 @@
 use super::loading::ramp_fraction;
 use super::mechanics::Mechanics;
 use super::time_step::{stable_step, StableStep};
-use super::{Probe, Record, Simulation, Unstable};
+use super::{PeakStop, Probe, Record, Simulation, Unstable};
 use crate::scene::Ramp;
 use nalgebra::SVector;
 use rayon::prelude::*;
@@ -59,6 +59,8 @@ pub struct Settings {
     pub tolerance: f64,
     pub max_iterations: usize,
     pub ramp: Ramp,
+    /// `loading.stop_after_peak` (see [`PeakStop`]).
+    pub stop_after_peak: Option<f64>,
 }
 
 /// What a relaxation run produced.
@@ -76,6 +78,8 @@ pub struct Relaxed {
     /// Largest ‖F_free‖/scale at the end of an increment.
     pub max_final_residual: f64,
     pub failure: Option<Unstable>,
+    /// Stopped after the peak (`loading.stop_after_peak`).
+    pub stopped_after_peak: bool,
 }
 
 /// Switch the dampers off and compute the stable limit of the undamped model.
@@ -297,6 +301,7 @@ pub fn relax<const D: usize, const K: usize>(
 ) -> Relaxed {
     let mut damping = AdaptiveDamping::new(sim);
     let mut predictor = Predictor::new(sim.x0.len());
+    let mut stop = PeakStop::new(s.stop_after_peak, probe);
     let mut r_prev = 0.0;
     let mut out = Relaxed {
         records: Vec::with_capacity(s.increments + 1),
@@ -315,6 +320,10 @@ pub fn relax<const D: usize, const K: usize>(
         out.records.extend(rec);
         out.wall_s.push(start.elapsed().as_secs_f64());
         out.iterations += 1;
+        if rec.is_some_and(|r| stop.reached(&r, sim)) {
+            out.stopped_after_peak = true;
+            return out;
+        }
         // Energy: the kernel books the prescribed jump by the trapezoid rule with the
         // reactions before and after it; the path from the converged state to the
         // predicted one, at the committed damage, did U(x_pred) − U(x^n) of work. Book the
