@@ -42,6 +42,32 @@ pub fn viridis(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+/// A chart on `root` with the axes of a force–displacement plot: reaction force (kN) against
+/// `displacement` (mm), both marked when their signs are turned (compression).
+pub fn force_displacement_axes<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    title: &str,
+    (x, y): (std::ops::Range<f64>, std::ops::Range<f64>),
+    displacement: &str,
+    turned: bool,
+) -> anyhow::Result<ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>> {
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x, y)
+        .map_err(err)?;
+    let turned = if turned { " (sign turned)" } else { "" };
+    chart
+        .configure_mesh()
+        .x_desc(format!("{displacement} (mm){turned}"))
+        .y_desc(format!("reaction force (kN){turned}"))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
+}
+
 /// force_displacement.svg: reaction of the probe group (kN) against its displacement (mm);
 /// a group pushed in the negative direction (compression) is plotted with both signs turned,
 /// so that the curve rises from the origin either way.
@@ -67,23 +93,13 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
     let group = o.summary.probe_group.clone().unwrap_or_else(|| "-".into());
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{}: force–displacement", o.summary.scene),
-            ("sans-serif", 22),
-        )
-        .margin(15)
-        .x_label_area_size(50)
-        .y_label_area_size(70)
-        .build_cartesian_2d(padded(x0, x1), padded(y0, y1))
-        .map_err(err)?;
-    let turned = if sign < 0.0 { " (sign turned)" } else { "" };
-    chart
-        .configure_mesh()
-        .x_desc(format!("displacement of group '{group}' (mm){turned}"))
-        .y_desc(format!("reaction force (kN){turned}"))
-        .draw()
-        .map_err(err)?;
+    let mut chart = force_displacement_axes(
+        &root,
+        &format!("{}: force–displacement", o.summary.scene),
+        (padded(x0, x1), padded(y0, y1)),
+        &format!("displacement of group '{group}'"),
+        sign < 0.0,
+    )?;
     chart
         .draw_series(LineSeries::new(pts.iter().copied(), BLUE.stroke_width(2)))
         .map_err(err)?;

@@ -2,7 +2,7 @@
 //! and dissipated energy against the lattice spacing with their extrapolated references.
 
 use super::runner::RunResult;
-use crate::output::plots::{err, padded};
+use crate::output::plots::{err, force_displacement_axes, padded};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -29,20 +29,13 @@ pub fn overlay(
     }
     let root = SVGBackend::new(path, (900, 620)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(15)
-        .x_label_area_size(50)
-        .y_label_area_size(70)
-        .build_cartesian_2d(padded(x0, x1), padded(y0, y1))
-        .map_err(err)?;
-    let turned = if sign < 0.0 { " (sign turned)" } else { "" };
-    chart
-        .configure_mesh()
-        .x_desc(format!("displacement (mm){turned}"))
-        .y_desc(format!("reaction force (kN){turned}"))
-        .draw()
-        .map_err(err)?;
+    let mut chart = force_displacement_axes(
+        &root,
+        title,
+        (padded(x0, x1), padded(y0, y1)),
+        "displacement",
+        sign < 0.0,
+    )?;
     for (k, r) in results.iter().enumerate() {
         let colour = Palette99::pick(k).to_rgba();
         chart
