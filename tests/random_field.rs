@@ -117,7 +117,8 @@ fn weibull_modulus_from_cov_round_trips() {
 /// Per realisation, 16 anchors on a 6ℓ lattice at grid-cell centres (where the interpolant's
 /// variance is lowest) and, for each lag, one partner in a random direction. With known mean 0
 /// and variance 1 the estimator r̂ = mean(X·Y) has SE √((1 + ρ²)/N); the variance estimator has
-/// SE √(2/N). Also maps the anchors to a lognormal and checks its moments.
+/// SE √(2/N); the paired difference of squares between a cell centre and its grid node is
+/// sharper (SE from its sample spread). Also maps the anchors to a lognormal and checks its moments.
 fn check_correlation(kernel: Correlation) {
     let realisations = 250u64;
     let lags = [0.5 * L, L, 2.0 * L];
@@ -125,6 +126,7 @@ fn check_correlation(kernel: Correlation) {
     let side = 24.0 * L;
     let mut prod = vec![Vec::new(); lags.len()];
     let mut anchors = Vec::new();
+    let mut centre_minus_node = Vec::new();
     let mut pick = 0x1234_5678u64;
     let mut next = || {
         pick ^= pick << 13;
@@ -143,6 +145,8 @@ fn check_correlation(kernel: Correlation) {
                 ];
                 let x = f.value_at(p).unwrap();
                 anchors.push(x);
+                let node = [p[0] - 0.5 * h, p[1] - 0.5 * h];
+                centre_minus_node.push(x * x - f.value_at(node).unwrap().powi(2));
                 for (k, &r) in lags.iter().enumerate() {
                     let th = 2.0 * std::f64::consts::PI * next();
                     let q = [p[0] + r * th.cos(), p[1] + r * th.sin()];
@@ -158,6 +162,20 @@ fn check_correlation(kernel: Correlation) {
     assert!(
         (var - 1.0).abs() < 4.0 * (2.0 / n).sqrt(),
         "{kernel:?}: variance at cell centres {var}"
+    );
+    // paired: the cell centre has the variance of the adjacent grid node (whose value is the
+    // embedded field itself); SE from the sample spread of the differences
+    let d_mean = centre_minus_node.iter().sum::<f64>() / n;
+    let d_sd = (centre_minus_node
+        .iter()
+        .map(|d| (d - d_mean).powi(2))
+        .sum::<f64>()
+        / (n - 1.0))
+        .sqrt();
+    assert!(
+        d_mean.abs() < 4.0 * d_sd / n.sqrt(),
+        "{kernel:?}: variance at cell centres minus at nodes {d_mean} (SE {})",
+        d_sd / n.sqrt()
     );
     for (k, &r) in lags.iter().enumerate() {
         let rho = kernel.rho(r, L);

@@ -436,10 +436,10 @@ fn fft2(planner: &mut FftPlanner<f64>, data: &mut [Complex<f64>], m1: usize, m2:
 fn smooth_size(n: usize) -> usize {
     let mut m = n.max(2);
     loop {
-        if m % 2 == 0 {
+        if m.is_multiple_of(2) {
             let mut r = m;
             for p in [2, 3, 5] {
-                while r % p == 0 {
+                while r.is_multiple_of(p) {
                     r /= p;
                 }
             }
