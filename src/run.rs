@@ -580,26 +580,20 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
             None,
         ),
     };
-    let mut summary = summarise(
+    let summary = summarise(
         &p,
-        sim.kernel(),
-        &records,
-        wall,
-        threads,
-        failure.as_ref().map(|e| e.to_string()),
+        &Finished {
+            kernel: sim.kernel(),
+            method,
+            report,
+            records: &records,
+            wall_s: &wall_s,
+            wall,
+            threads,
+            failure: failure.as_ref().map(|e| e.to_string()),
+        },
         damage.as_deref(),
     );
-    summary.solver_method = method;
-    summary.iterations = report.iterations;
-    summary.increments = report.increments;
-    summary.unconverged_increments = report.unconverged_increments;
-    summary.max_final_residual = report.max_final_residual;
-    summary.stopped_after_peak = report.stopped_after_peak;
-    summary.wall_time_to_peak_s = records
-        .iter()
-        .position(|r| r.step == summary.peak_step)
-        .and_then(|i| wall_s.get(i).copied())
-        .unwrap_or(wall);
     let outcome = Outcome {
         summary,
         records,
@@ -680,15 +674,31 @@ fn run_explicit(
     (records, wall_s, failure, stopped)
 }
 
-fn summarise(
-    p: &Prepared,
+/// What a finished run hands to its summary.
+struct Finished<'a> {
     kernel: crate::solver::KernelSet,
-    records: &[Record],
+    method: SolverMethod,
+    report: SolverReport,
+    records: &'a [Record],
+    /// Wall time (s since the start) at each record.
+    wall_s: &'a [f64],
     wall: f64,
     threads: usize,
     failure: Option<String>,
-    damage: Option<&[ParticleDamage]>,
-) -> Summary {
+}
+
+fn summarise(p: &Prepared, run: &Finished, damage: Option<&[ParticleDamage]>) -> Summary {
+    let Finished {
+        kernel,
+        method,
+        report,
+        records,
+        wall_s,
+        wall,
+        threads,
+        ..
+    } = *run;
+    let failure = run.failure.clone();
     let sign = p
         .probe
         .as_ref()
@@ -741,14 +751,17 @@ fn summarise(
         fundamental_period_s: p.fundamental.period,
         t_end_s: p.t_end,
         wall_time_s: wall,
-        wall_time_to_peak_s: wall,
+        wall_time_to_peak_s: peak
+            .and_then(|pk| records.iter().position(|r| r.step == pk.step))
+            .and_then(|i| wall_s.get(i).copied())
+            .unwrap_or(wall),
         peak_step: peak.map(|r| r.step).unwrap_or(0),
-        solver_method: SolverMethod::Explicit,
-        iterations: None,
-        increments: None,
-        unconverged_increments: None,
-        max_final_residual: None,
-        stopped_after_peak: false,
+        solver_method: method,
+        iterations: report.iterations,
+        increments: report.increments,
+        unconverged_increments: report.unconverged_increments,
+        max_final_residual: report.max_final_residual,
+        stopped_after_peak: report.stopped_after_peak,
         threads,
         probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),
         peak_force_n: peak.map(|r| r.force_n * sign).unwrap_or(0.0),

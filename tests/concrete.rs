@@ -4,61 +4,18 @@
 
 mod common;
 
+use common::tension_block;
+
 use nalgebra::Vector2;
 use sppm::run::{build_simulation, prepare, run, RunOptions};
 use sppm::solver::concrete;
 use sppm::Scene;
 
-/// A block 150 mm wide, `height` high, 150 mm thick, of the Table 1 concrete, pulled at the
-/// top rows by 1.5·COD_c (the default), held at the bottom rows, one particle held in x.
-fn block(height: f64, spacing: f64, overrides: &[&str]) -> Scene {
-    let text = format!(
-        r#"
-name = "block"
-[body]
-shape = "rectangle"
-width = 0.15
-height = {height}
-[discretisation]
-spacing = {spacing}
-[material]
-nu = 0.2
-rho = 2323.0
-thickness = 0.15
-[concrete]
-preset = "splm_block"
-ft = 2.6168e6
-fy = 22.983e6
-[[groups]]
-name = "bottom"
-select = {{ by = "edge", edge = "bottom", rows = 2 }}
-fix = ["y"]
-[[groups]]
-name = "anchor"
-select = {{ by = "nearest", point = [0.075, 0.0] }}
-fix = ["x"]
-[[groups]]
-name = "top"
-select = {{ by = "edge", edge = "top", rows = 2 }}
-load = {{ component = "y" }}
-[loading]
-end_periods = 60.0
-[damping]
-internal = 0.2
-external = 0.2
-[output]
-records = 400
-"#
-    );
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Scene::from_toml_str(&text, &o).unwrap()
-}
-
 /// With strengths no load reaches, the concrete kernel follows the elastic one: the same
 /// force history to round-off (different summation order only).
 #[test]
 fn undamaged_concrete_kernel_is_the_elastic_kernel() {
-    let mut with = block(
+    let mut with = tension_block(
         0.1,
         0.01,
         &[
@@ -100,7 +57,7 @@ fn undamaged_concrete_kernel_is_the_elastic_kernel() {
 /// and it feels none itself; Newton's third law holds exactly with damage.
 #[test]
 fn fully_damaged_particle_transmits_no_force() {
-    let scene = block(0.1, 0.01, &[]);
+    let scene = tension_block(0.1, 0.01, &[]);
     let mut p = prepare(&scene).unwrap();
     let mut sim = build_simulation(&mut p);
     let n = sim.x0.len();
@@ -143,7 +100,7 @@ fn fully_damaged_particle_transmits_no_force() {
 #[test]
 fn uniaxial_tension_reaches_ft_and_dissipates_gf() {
     for spacing in [0.01, 0.005] {
-        let scene = block(0.1, spacing, &[]);
+        let scene = tension_block(0.1, spacing, &[]);
         let law = scene.concrete_law().unwrap();
         let area = 0.15 * 0.15;
         let mut p = prepare(&scene).unwrap();
@@ -208,7 +165,7 @@ fn uniaxial_tension_reaches_ft_and_dissipates_gf() {
 /// is uniform to about 1% away from the grips.
 #[test]
 fn plastic_block_carries_the_hardening_yield_stress() {
-    let scene = block(
+    let scene = tension_block(
         0.15,
         0.01,
         &[
@@ -248,7 +205,7 @@ fn plastic_block_carries_the_hardening_yield_stress() {
 #[test]
 fn concrete_results_do_not_depend_on_the_thread_count() {
     // 5 mm: about 700 particles, three work items of at least 256 particles
-    let scene = block(0.1, 0.005, &["loading.end_periods=20"]);
+    let scene = tension_block(0.1, 0.005, &["loading.end_periods=20"]);
     let one = run(
         &scene,
         &RunOptions {
@@ -284,7 +241,7 @@ fn tension_kernel_matches_the_full_kernel_bit_for_bit() {
         "concrete.compressive_damage=false",
         "concrete.plasticity=false",
     ];
-    let scene = block(0.1, 0.01, &tension_only);
+    let scene = tension_block(0.1, 0.01, &tension_only);
     let mut runs = Vec::new();
     for force_full in [false, true] {
         let mut p = prepare(&scene).unwrap();
@@ -316,7 +273,7 @@ fn tension_kernel_matches_the_full_kernel_bit_for_bit() {
     }
     // the summary names the kernel of each feature set
     let kernel_of = |o: &[&str]| {
-        let mut p = prepare(&block(0.1, 0.01, o)).unwrap();
+        let mut p = prepare(&tension_block(0.1, 0.01, o)).unwrap();
         build_simulation(&mut p).kernel()
     };
     assert_eq!(
@@ -339,9 +296,13 @@ fn stop_after_peak_keeps_the_peak_and_saves_the_tail() {
         threads: Some(2),
         ..Default::default()
     };
-    let full = run(&block(0.1, 0.01, &["loading.end_periods=20"]), &opts).unwrap();
+    let full = run(
+        &tension_block(0.1, 0.01, &["loading.end_periods=20"]),
+        &opts,
+    )
+    .unwrap();
     let stop = run(
-        &block(
+        &tension_block(
             0.1,
             0.01,
             &["loading.end_periods=20", "loading.stop_after_peak=0.5"],

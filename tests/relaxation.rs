@@ -99,41 +99,7 @@ fn relaxation_does_not_depend_on_the_thread_count() {
 /// asserts (tests/concrete.rs).
 #[test]
 fn relaxed_tension_block_reaches_ft() {
-    let text = r#"
-name = "block"
-[body]
-shape = "rectangle"
-width = 0.15
-height = 0.1
-[discretisation]
-spacing = 0.01
-[material]
-nu = 0.2
-rho = 2323.0
-thickness = 0.15
-[concrete]
-preset = "splm_block"
-ft = 2.6168e6
-fy = 22.983e6
-[[groups]]
-name = "bottom"
-select = { by = "edge", edge = "bottom", rows = 2 }
-fix = ["y"]
-[[groups]]
-name = "anchor"
-select = { by = "nearest", point = [0.075, 0.0] }
-fix = ["x"]
-[[groups]]
-name = "top"
-select = { by = "edge", edge = "top", rows = 2 }
-load = { component = "y" }
-[solver]
-method = "relaxation"
-[output]
-map = false
-vtk = false
-"#;
-    let scene = Scene::from_toml_str(text, &[]).unwrap();
+    let scene = tension_block(0.1, 0.01, &["solver.method=relaxation"]);
     let law = scene.concrete_law().unwrap();
     let area = 0.15 * 0.15;
     let out = run(&scene, 2);

@@ -27,18 +27,8 @@ pub enum StudyCommand {
         /// Tensile damage w_t at and above which a particle belongs to the crack path.
         #[arg(long, default_value_t = CRACK_PATH_DAMAGE)]
         crack_damage: f64,
-        /// Override a scene value in every run (repeatable).
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Study folder (default: output/<scene name>-objectivity).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Runs at a time, each on one thread (default: the number of cores).
-        #[arg(long)]
-        jobs: Option<usize>,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
+        #[command(flatten)]
+        common: StudyOptions,
     },
     /// Run a scene at several lattice spacings and extrapolate the peak force and the
     /// dissipated energy (output/<scene>-convergence/).
@@ -47,16 +37,26 @@ pub enum StudyCommand {
         /// Lattice spacings L0 in m, comma-separated.
         #[arg(long)]
         spacings: String,
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Study folder (default: output/<scene name>-convergence).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        #[arg(long)]
-        jobs: Option<usize>,
-        #[arg(long)]
-        quiet: bool,
+        #[command(flatten)]
+        common: StudyOptions,
     },
+}
+
+/// The options every study takes.
+#[derive(clap::Args)]
+pub struct StudyOptions {
+    /// Override a scene value in every run (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Study folder (default: output/<scene name>-<study>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Runs at a time, each on one thread (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// A comma-separated list of numbers; `option` names it in the message.
@@ -91,10 +91,13 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
             offsets,
             seed,
             crack_damage,
-            set,
-            out,
-            jobs,
-            quiet,
+            common:
+                StudyOptions {
+                    set,
+                    out,
+                    jobs,
+                    quiet,
+                },
         } => {
             let report = objectivity(&ObjectivityArgs {
                 crack_damage,
@@ -116,10 +119,13 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
         StudyCommand::Convergence {
             scene,
             spacings,
-            set,
-            out,
-            jobs,
-            quiet,
+            common:
+                StudyOptions {
+                    set,
+                    out,
+                    jobs,
+                    quiet,
+                },
         } => {
             let report = convergence(&ConvergenceArgs {
                 scene,

@@ -124,3 +124,48 @@ pub fn measure_e_nu(p: &Prepared, width: f64, height: f64, thickness: f64) -> (f
     let sigma = f / (width * thickness);
     (sigma / eyy, -exx / eyy)
 }
+
+/// A block 150 mm wide, `height` high, 150 mm thick, of the Table 1 concrete, pulled at the
+/// top rows by 1.5·COD_c (the default), held at the bottom rows, one particle held in x.
+pub fn tension_block(height: f64, spacing: f64, overrides: &[&str]) -> Scene {
+    let text = format!(
+        r#"
+name = "block"
+[body]
+shape = "rectangle"
+width = 0.15
+height = {height}
+[discretisation]
+spacing = {spacing}
+[material]
+nu = 0.2
+rho = 2323.0
+thickness = 0.15
+[concrete]
+preset = "splm_block"
+ft = 2.6168e6
+fy = 22.983e6
+[[groups]]
+name = "bottom"
+select = {{ by = "edge", edge = "bottom", rows = 2 }}
+fix = ["y"]
+[[groups]]
+name = "anchor"
+select = {{ by = "nearest", point = [0.075, 0.0] }}
+fix = ["x"]
+[[groups]]
+name = "top"
+select = {{ by = "edge", edge = "top", rows = 2 }}
+load = {{ component = "y" }}
+[loading]
+end_periods = 60.0
+[damping]
+internal = 0.2
+external = 0.2
+[output]
+records = 400
+"#
+    );
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    Scene::from_toml_str(&text, &o).unwrap()
+}
