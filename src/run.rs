@@ -429,7 +429,7 @@ pub struct Summary {
     pub offset_m: [f64; 2],
     pub omega_max_rad_s: f64,
     pub omega_max_bound_rad_s: f64,
-    /// No random choice is made by the elastic lattice; recorded for reproducibility.
+    /// The scene's seed (`Scene::effective_seed`), `None` when it makes no random choice.
     pub seed: Option<u64>,
     pub sppm_version: String,
 }
@@ -795,7 +795,7 @@ fn summarise(p: &Prepared, run: &Finished, damage: Option<&[ParticleDamage]>) ->
         offset_m: d.offset,
         omega_max_rad_s: p.stable.omega_max,
         omega_max_bound_rad_s: p.stable.omega_max_bound,
-        seed: None,
+        seed: p.model.scene.effective_seed(),
         sppm_version: env!("CARGO_PKG_VERSION").to_string(),
     }
 }

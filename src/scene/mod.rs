@@ -24,12 +24,19 @@ pub struct Scene {
     /// Free text shown in the summary.
     #[serde(default)]
     pub description: Option<String>,
+    /// The seed of every random choice the scene makes (its random fields); recorded in the
+    /// summary. Defaults to [`DEFAULT_SEED`] when the scene has random fields.
+    #[serde(default)]
+    pub seed: Option<u64>,
     pub body: BodySpec,
     pub discretisation: DiscretisationSpec,
     pub material: MaterialSpec,
     /// Concrete damage and plasticity (MODEL.md §6–9, §11); its presence turns them on.
     #[serde(default)]
     pub concrete: Option<ConcreteSpec>,
+    /// Random-field material properties (MODEL.md §12), one table per property.
+    #[serde(default)]
+    pub random_field: Vec<RandomFieldSpec>,
     #[serde(default)]
     pub groups: Vec<GroupSpec>,
     #[serde(default)]
@@ -44,6 +51,84 @@ pub struct Scene {
     /// correlation), filled by [`Scene::resolve`]; not read from the file.
     #[serde(skip_deserializing)]
     pub derived: Vec<Derived>,
+}
+
+/// The seed of a scene's random choices when it gives none.
+pub const DEFAULT_SEED: u64 = 20_240_401;
+
+/// A material property that a random field can vary per particle (MODEL.md §12).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+pub enum FieldProperty {
+    /// Tensile strength f't.
+    #[serde(rename = "ft")]
+    Ft,
+    /// Young's modulus E.
+    #[serde(rename = "E")]
+    E,
+    /// Fracture energy G_f.
+    #[serde(rename = "Gf")]
+    Gf,
+    /// Compressive strength f'c (with f_y and f_ult in proportion).
+    #[serde(rename = "fc")]
+    Fc,
+}
+
+impl FieldProperty {
+    /// The name as a scene writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            FieldProperty::Ft => "ft",
+            FieldProperty::E => "E",
+            FieldProperty::Gf => "Gf",
+            FieldProperty::Fc => "fc",
+        }
+    }
+}
+
+/// Correlation function of a random field (`random_field.correlation`).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CorrelationKind {
+    Exponential,
+    SquaredExponential,
+}
+
+/// One-point distribution of a random field (`random_field.marginal`).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum MarginalKind {
+    /// Normal truncated at zero.
+    Normal,
+    Lognormal,
+    Weibull,
+}
+
+/// `[[random_field]]`: one material property drawn per particle from a correlated random
+/// field (MODEL.md §12).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomFieldSpec {
+    pub property: FieldProperty,
+    pub correlation: CorrelationKind,
+    /// Correlation length ℓ in m; 0 gives an uncorrelated (white) field.
+    pub length: f64,
+    pub marginal: MarginalKind,
+    /// Mean of the property; defaults to its deterministic value (scene, preset or correlation).
+    #[serde(default)]
+    pub mean: Option<f64>,
+    /// Coefficient of variation (give this or, for Weibull, `modulus`).
+    #[serde(default)]
+    pub cov: Option<f64>,
+    /// Weibull modulus m (instead of `cov`).
+    #[serde(default)]
+    pub modulus: Option<f64>,
+    /// Seed of this field; defaults to one derived from the scene's `seed` and the property.
+    #[serde(default)]
+    pub seed: Option<u64>,
+    /// Only for `property = "ft"`: G_f follows f't in proportion, G_f,i = G_f·f't,i/mean, so
+    /// that COD_c stays the same everywhere.
+    #[serde(default)]
+    pub tie_gf: bool,
 }
 
 /// The specimen's shape (`[body] shape = "..."`). Lengths in metres.
@@ -595,5 +680,15 @@ impl Scene {
 
     pub fn name(&self) -> &str {
         self.name.as_deref().unwrap_or("scene")
+    }
+
+    /// The seed of the scene's random choices: `seed`, else [`DEFAULT_SEED`] if the scene
+    /// makes any (random fields), else `None`.
+    pub fn effective_seed(&self) -> Option<u64> {
+        self.seed.or(if self.random_field.is_empty() {
+            None
+        } else {
+            Some(DEFAULT_SEED)
+        })
     }
 }
