@@ -4,6 +4,7 @@
 
 use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
 use crate::material;
+use crate::material::properties::{self, FieldReport, SampledField};
 use crate::model::micro_modulus::{self, MicroModuli};
 use crate::model::stress::StressSum;
 use crate::scene::{Scene, SceneError, SolverMethod};
@@ -90,6 +91,8 @@ pub struct Model {
     pub mech: Mechanics<2, 6>,
     pub bulk: MicroModuli,
     pub surface: SurfaceCorrection,
+    /// The scene's random fields sampled at the particles (MODEL.md §12).
+    pub fields: Vec<SampledField>,
 }
 
 /// Discretise a scene and assemble its model: lattice, groups, supports, micro-moduli.
@@ -225,6 +228,19 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
             None => surface.kept_bulk += 1,
         }
     }
+    // Random fields (MODEL.md §12), over the body's box: E scales the micro-moduli here, the
+    // concrete values go to the damage kernel (`build_simulation`).
+    // The box is widened by a margin that does not depend on the spacing (particles may sit
+    // on the outline within the lattice fill's tolerance, 1e-9·size).
+    let (lo, hi) = shape.bounding_box();
+    let pad = Vector2::repeat(1e-6 * shape.size().max(1.0));
+    let fields = properties::sample(scene, lo - pad, hi + pad, &particles.x0)?;
+    if let Some(f) = properties::stiffness_factors(&fields, m.youngs_modulus()) {
+        for i in 0..n {
+            a[i] *= f[i];
+            b[i] *= f[i];
+        }
+    }
     let rho = vec![m.rho; n];
     let mech = Mechanics::new(&particles, a, b, &rho);
     Ok(Model {
@@ -236,6 +252,7 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
         mech,
         bulk,
         surface,
+        fields,
     })
 }
 
@@ -431,6 +448,8 @@ pub struct Summary {
     pub omega_max_bound_rad_s: f64,
     /// The scene's seed (`Scene::effective_seed`), `None` when it makes no random choice.
     pub seed: Option<u64>,
+    /// Each random field: its parameters, seed and the statistics of the particles' values.
+    pub random_fields: Vec<FieldReport>,
     pub sppm_version: String,
 }
 
@@ -445,6 +464,8 @@ pub struct Outcome {
     pub damage: Option<Vec<ParticleDamage>>,
     pub groups: Vec<groups::Group>,
     pub scene: Scene,
+    /// The random fields' values at each particle (MODEL.md §12).
+    pub fields: Vec<SampledField>,
 }
 
 impl Outcome {
@@ -508,7 +529,9 @@ pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
         integration,
     );
     if let Some(law) = p.model.scene.concrete_law() {
-        sim.inelastic = Some(Box::new(Concrete::new(law, &p.model.particles)));
+        let mut c = Concrete::new(law, &p.model.particles);
+        c.local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
+        sim.inelastic = Some(Box::new(c));
     }
     sim
 }
@@ -603,6 +626,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
         damage,
         groups: p.model.groups.clone(),
         scene: p.model.scene.clone(),
+        fields: p.model.fields.clone(),
     };
     Ok(outcome)
 }
@@ -796,6 +820,7 @@ fn summarise(p: &Prepared, run: &Finished, damage: Option<&[ParticleDamage]>) ->
         omega_max_rad_s: p.stable.omega_max,
         omega_max_bound_rad_s: p.stable.omega_max_bound,
         seed: p.model.scene.effective_seed(),
+        random_fields: p.model.fields.iter().map(|f| f.report.clone()).collect(),
         sppm_version: env!("CARGO_PKG_VERSION").to_string(),
     }
 }

@@ -1,5 +1,6 @@
 //! Elastic constants and the values derived from them for the dampers (MODEL.md §5).
 pub mod concrete;
+pub mod properties;
 pub mod random_field;
 
 /// Bulk modulus κ = E/(3(1−2ν)) as the source uses it for the wave speed (3.57).

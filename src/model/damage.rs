@@ -33,6 +33,55 @@ pub struct ConcreteLaw {
     pub crack_band: f64,
 }
 
+/// The values of the law that a random field varies per particle (MODEL.md §12; see
+/// `material::properties`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalProperties {
+    pub e: f64,
+    pub ft: f64,
+    pub fc: f64,
+    pub fy: f64,
+    pub fult: f64,
+    pub gf: f64,
+    pub cod_c: f64,
+    pub cod_1: f64,
+}
+
+impl ConcreteLaw {
+    /// A particle's values for E, f't, f'c and G_f: COD_c from (5.4) with the law's α and γ,
+    /// f_y and f_ult in proportion to f'c.
+    pub fn local(&self, e: f64, ft: f64, fc: f64, gf: f64) -> LocalProperties {
+        let alpha = self.cod_1 / self.cod_c;
+        let cod_c = crate::material::concrete::critical_crack_opening(gf, ft, alpha, self.gamma);
+        LocalProperties {
+            e,
+            ft,
+            fc,
+            fy: self.fy * fc / self.fc,
+            fult: self.fult * fc / self.fc,
+            gf,
+            cod_c,
+            cod_1: alpha * cod_c,
+        }
+    }
+
+    /// This law with a particle's own values.
+    #[inline]
+    pub fn with(&self, l: &LocalProperties) -> ConcreteLaw {
+        ConcreteLaw {
+            e: l.e,
+            ft: l.ft,
+            fc: l.fc,
+            fy: l.fy,
+            fult: l.fult,
+            gf: l.gf,
+            cod_c: l.cod_c,
+            cod_1: l.cod_1,
+            ..*self
+        }
+    }
+}
+
 /// Damage factor of a bond whose two particles have damage w_i and w_j (3.37): the two
 /// springs in series, d = 2(1−w_i)(1−w_j)/(2−w_i−w_j); 0 when either is fully damaged
 /// (including the 0/0 case w_i = w_j = 1). Symmetric bit for bit in (w_i, w_j), so that

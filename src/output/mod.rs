@@ -1,5 +1,6 @@
 //! Reports of a run (ARCHITECTURE.md, "Interfaces"): summary.json, force_displacement.csv, particles.csv,
-//! force_displacement.svg, crack_map.svg (scenes with damage), particle_map.svg and particles.vtk in the run's folder.
+//! force_displacement.svg, crack_map.svg (scenes with damage), random_field_<property>.svg (each
+//! random field, with the crack on top), particle_map.svg and particles.vtk in the run's folder.
 
 pub mod csv;
 pub mod fields;
@@ -35,6 +36,11 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
     if outcome.damage.is_some() {
         let f = dir.join("crack_map.svg");
         plots::crack_map(outcome, o.crack_map_scale, &f)?;
+        files.push(f);
+    }
+    for (k, field) in outcome.fields.iter().enumerate() {
+        let f = dir.join(format!("random_field_{}.svg", field.property.name()));
+        plots::field_map(outcome, k, o.crack_map_scale, &f)?;
         files.push(f);
     }
     if o.map {

@@ -207,7 +207,40 @@ impl Frame {
 
 /// particle_map.svg: every particle as a disc coloured by `field`, at x0 + scale·u.
 pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyhow::Result<()> {
-    let values = fields::values(o, field);
+    value_map(
+        o,
+        &fields::values(o, field),
+        fields::label(field),
+        scale,
+        false,
+        path,
+    )
+}
+
+/// random_field_<property>.svg: a random field's values (MODEL.md §12) at every particle, at
+/// x0 + scale·u, with the cracked particles (w_t ≥ 0.99) drawn as black dots on top, so the
+/// crack can be read against the field.
+pub fn field_map(o: &Outcome, k: usize, scale: f64, path: &Path) -> anyhow::Result<()> {
+    let f = &o.fields[k];
+    let (name, unit) = f.label();
+    let values: Vec<f64> = f.values.iter().map(|v| v * unit).collect();
+    let label = format!(
+        "random field {name} (seed {}; black: w_t ≥ 0.99)",
+        f.report.seed
+    );
+    value_map(o, &values, &label, scale, true, path)
+}
+
+/// Particles as discs coloured by `values` (viridis over the 1st–99th percentile) with a
+/// colour bar; with `cracks`, the cracked particles as black dots.
+fn value_map(
+    o: &Outcome,
+    values: &[f64],
+    label: &str,
+    scale: f64,
+    cracks: bool,
+    path: &Path,
+) -> anyhow::Result<()> {
     let frame = Frame::new(o, scale);
     // colour range: 1st to 99th percentile, so that a few boundary particles (whose
     // one-sided bond sums give low particle stresses) do not wash out the interior
@@ -224,17 +257,29 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
     let root = SVGBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
     let (main, bar) = root.split_horizontally(width - 140);
-    let mut chart = frame.chart(&main, o, fields::label(field), scale, "x (mm)".into(), 40)?;
+    let mut chart = frame.chart(&main, o, label, scale, "x (mm)".into(), 40)?;
     let radius = frame.radius;
     chart
         .draw_series(
             frame
                 .pos
                 .iter()
-                .zip(&values)
+                .zip(values)
                 .map(|(&p, &v)| Circle::new(p, radius, viridis((v - vmin) / span).filled())),
         )
         .map_err(err)?;
+    if let (true, Some(damage)) = (cracks, &o.damage) {
+        chart
+            .draw_series(
+                frame
+                    .pos
+                    .iter()
+                    .zip(damage)
+                    .filter(|(_, d)| d.wt >= 0.99)
+                    .map(|(&p, _)| Circle::new(p, (radius / 2).max(1), BLACK.filled())),
+            )
+            .map_err(err)?;
+    }
     // colour bar
     let mut cb = ChartBuilder::on(&bar)
         .caption("1st–99th pct", ("sans-serif", 13))

@@ -1,6 +1,6 @@
 //! Legacy binary VTK (an unstructured grid of vertex cells, one per particle) for ParaView,
 //! with displacement, stress tensor, von Mises and maximum principal stress, and group
-//! membership as point data. Checked with meshio's reader.
+//! membership as point data, and each random field's values (e.g. `ft_MPa`). Checked with meshio's reader.
 
 use super::fields;
 use crate::run::Outcome;
@@ -79,6 +79,14 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
             for p in d {
                 be(&mut w, get(p))?;
             }
+        }
+    }
+    // random fields (MODEL.md §12), in the units of their names
+    for f in &o.fields {
+        let (name, unit) = f.label();
+        writeln!(w, "\nSCALARS {name} float 1\nLOOKUP_TABLE default")?;
+        for v in &f.values {
+            be(&mut w, v * unit)?;
         }
     }
     for g in &o.groups {

@@ -78,6 +78,7 @@ impl Scene {
             }
         }
         self.validate_body()?;
+        crate::material::properties::check(self)?;
         let d = &self.discretisation;
         if d.lattice != "hexagonal" {
             return Err(invalid(

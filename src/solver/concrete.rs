@@ -37,7 +37,7 @@ use super::kernel::central_difference;
 use super::mechanics::Mechanics;
 use super::KernelSet;
 use crate::discretise::{Particles, NONE};
-use crate::model::damage::{self, ConcreteLaw};
+use crate::model::damage::{self, ConcreteLaw, LocalProperties};
 use crate::model::micro_modulus::elasticity_matrix;
 use crate::model::plasticity;
 use crate::model::strain::{self, StrainFit};
@@ -81,6 +81,9 @@ pub struct Concrete<const K: usize> {
     /// Run the full kernel even where the law needs only the tension kernel (for tests that
     /// compare the two).
     pub force_full: bool,
+    /// Each particle's own E, f't, f'c, G_f (random fields, MODEL.md §12); `None`: the law's
+    /// values everywhere.
+    pub local: Option<Vec<LocalProperties>>,
 }
 
 impl<const K: usize> Concrete<K> {
@@ -110,6 +113,7 @@ impl<const K: usize> Concrete<K> {
             sps_trial: vec![[0.0; K]; n],
             cache: vec![[SlotCache::default(); K]; n],
             force_full: false,
+            local: None,
         }
     }
 
@@ -270,7 +274,14 @@ fn update_state<const K: usize, const FULL: bool>(
         };
     }
     let b_theta = m.b[i] * theta;
-    let law = &c.law;
+    let local_law;
+    let law = match &c.local {
+        Some(l) => {
+            local_law = c.law.with(&l[i]);
+            &local_law
+        }
+        None => &c.law,
+    };
     let mut p = c.committed[i];
     if FULL {
         *sps_trial = c.sps[i];
@@ -290,7 +301,9 @@ fn update_state<const K: usize, const FULL: bool>(
         } else {
             strain::strain_tensor(fit, &dse)
         };
-        let sv = c.d * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
+        // D is linear in E: a particle's own E scales the law's D.
+        let sv = (c.d * (law.e / c.law.e))
+            * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
         Matrix2::new(sv[0], sv[2], sv[2], sv[1])
     };
 

@@ -1,0 +1,352 @@
+//! Per-particle material properties from a scene's `[[random_field]]` tables (MODEL.md §12).
+//!
+//! Each table draws one property (f't, E, G_f or f'c) at every particle as
+//! `marginal.map(g(x0))`, g the standard Gaussian field of [`GaussianField`] generated over the
+//! body's bounding box (not the particles' box, so that every lattice filling the body samples
+//! the same field). The mean defaults to the property's deterministic value (scene, preset or
+//! correlation, MODEL.md §11).
+//!
+//! **Seeds.** A table's `seed` if given, else `splitmix64(scene seed ^ tag(property))`, so that
+//! the properties of one scene are independent fields and one scene seed fixes them all.
+//!
+//! **Decisions where the source is silent.**
+//! - E varies the micro-moduli a_i and b_i in proportion (they are linear in E, (3.11)); a bond
+//!   between particles of different E takes the mean (a_i + a_j)/2 as the kernel always does.
+//!   The stable time step is computed from the varied stiffness, so it shrinks with the
+//!   stiffest particle.
+//! - f'c varies f_y and f_ult in the same proportion (they are fixed fractions of f'c, §9).
+//! - `tie_gf` makes G_f,i = G_f·f't,i/mean(f't): the critical opening COD_c (5.4) stays the
+//!   same everywhere and the fracture energy follows the strength.
+//! - Without ties, COD_c,i = 2·G_f,i/(f't,i·(α + γ)) at each particle, so a weak particle
+//!   softens more gently.
+
+use crate::material::random_field::{Correlation, FieldError, GaussianField, Marginal};
+use crate::model::damage::{ConcreteLaw, LocalProperties};
+use crate::scene::{
+    CorrelationKind, FieldProperty, MarginalKind, RandomFieldSpec, Scene, SceneError,
+};
+use nalgebra::Vector2;
+use serde::Serialize;
+
+/// What the summary reports of one sampled field.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct FieldReport {
+    pub property: FieldProperty,
+    pub correlation: CorrelationKind,
+    pub length_m: f64,
+    pub marginal: MarginalKind,
+    /// Target mean and CoV of the marginal (for Weibull, those of its modulus and scale).
+    pub mean: f64,
+    pub cov: f64,
+    /// Weibull modulus, for a Weibull marginal.
+    pub modulus: Option<f64>,
+    pub seed: u64,
+    pub tie_gf: bool,
+    /// Grid spacing h of the generated field (none for white noise).
+    pub grid_spacing_m: Option<f64>,
+    /// Share of the circulant embedding's spectrum clipped (negative eigenvalues).
+    pub clipped_fraction: Option<f64>,
+    /// Statistics of the particles' values.
+    pub sample_mean: f64,
+    pub sample_cov: f64,
+    pub sample_min: f64,
+    pub sample_max: f64,
+}
+
+/// One property's values at every particle.
+#[derive(Clone, Debug)]
+pub struct SampledField {
+    pub property: FieldProperty,
+    pub values: Vec<f64>,
+    pub report: FieldReport,
+}
+
+impl SampledField {
+    /// Name and unit for maps and VTK, e.g. `ft_MPa`.
+    pub fn label(&self) -> (&'static str, f64) {
+        match self.property {
+            FieldProperty::Ft => ("ft_MPa", 1e-6),
+            FieldProperty::E => ("E_GPa", 1e-9),
+            FieldProperty::Gf => ("Gf_N_per_m", 1.0),
+            FieldProperty::Fc => ("fc_MPa", 1e-6),
+        }
+    }
+}
+
+/// Tag of a property in the seed hash.
+fn tag(p: FieldProperty) -> u64 {
+    match p {
+        FieldProperty::Ft => 0x6674_5f66_6965_6c64, // "ft_field"
+        FieldProperty::E => 0x455f_5f66_6965_6c64,
+        FieldProperty::Gf => 0x4766_5f66_6965_6c64,
+        FieldProperty::Fc => 0x6663_5f66_6965_6c64,
+    }
+}
+
+/// SplitMix64 finaliser.
+pub fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The seed of a field: its own, else derived from the scene's seed and the property.
+pub fn field_seed(scene_seed: u64, spec: &RandomFieldSpec) -> u64 {
+    spec.seed
+        .unwrap_or_else(|| splitmix64(scene_seed ^ tag(spec.property)))
+}
+
+/// The deterministic value of a property in a resolved scene (the default mean).
+pub fn deterministic_value(scene: &Scene, p: FieldProperty) -> Option<f64> {
+    match p {
+        FieldProperty::E => Some(scene.material.youngs_modulus()),
+        FieldProperty::Ft => scene.derived_value("ft"),
+        FieldProperty::Gf => scene.derived_value("Gf"),
+        FieldProperty::Fc => scene.derived_value("fc"),
+    }
+}
+
+/// A field error as a scene error on `random_field[k]`.
+fn scene_error(k: usize, e: FieldError) -> SceneError {
+    match e {
+        FieldError::Parameter {
+            name,
+            value,
+            allowed,
+        } => {
+            let key = match name {
+                "correlation_length" => "length",
+                n => n,
+            };
+            SceneError::Invalid {
+                key: format!("random_field[{k}].{key}"),
+                value: value.to_string(),
+                allowed: allowed.to_string(),
+            }
+        }
+        other => SceneError::Invalid {
+            key: format!("random_field[{k}]"),
+            value: "(the field)".into(),
+            allowed: other.to_string(),
+        },
+    }
+}
+
+/// The marginal of table k of a resolved scene (checks the table's values).
+pub fn marginal(scene: &Scene, k: usize) -> Result<Marginal, SceneError> {
+    let spec = &scene.random_field[k];
+    let mean = match spec.mean {
+        Some(m) => m,
+        None => deterministic_value(scene, spec.property).ok_or_else(|| SceneError::Invalid {
+            key: format!("random_field[{k}].property"),
+            value: spec.property.name().into(),
+            allowed: "E in any scene; ft, Gf and fc only in a scene with [concrete] (or give random_field.mean)".into(),
+        })?,
+    };
+    let m = match (spec.marginal, spec.cov, spec.modulus) {
+        (_, Some(_), Some(_)) => {
+            return Err(SceneError::Invalid {
+                key: format!("random_field[{k}].modulus"),
+                value: format!("{:?}", spec.modulus.unwrap()),
+                allowed: "give either cov or (for a Weibull marginal) modulus, not both".into(),
+            })
+        }
+        (MarginalKind::Weibull, None, Some(m)) => Marginal::weibull_modulus(mean, m),
+        (_, None, Some(m)) => {
+            return Err(SceneError::Invalid {
+                key: format!("random_field[{k}].modulus"),
+                value: m.to_string(),
+                allowed: "only a Weibull marginal takes a modulus; give cov".into(),
+            })
+        }
+        (_, None, None) => {
+            return Err(SceneError::Invalid {
+                key: format!("random_field[{k}].cov"),
+                value: "(missing)".into(),
+                allowed: "the coefficient of variation, a number > 0 (or modulus for Weibull)"
+                    .into(),
+            })
+        }
+        (MarginalKind::Normal, Some(c), None) => Marginal::normal(mean, c),
+        (MarginalKind::Lognormal, Some(c), None) => Marginal::lognormal(mean, c),
+        (MarginalKind::Weibull, Some(c), None) => Marginal::weibull(mean, c),
+    };
+    m.map_err(|e| scene_error(k, e))
+}
+
+/// Check every `[[random_field]]` table of a resolved scene: values, one table per property,
+/// `tie_gf` only on f't and not beside a G_f field, f't/G_f/f'c only with `[concrete]`.
+pub fn check(scene: &Scene) -> Result<(), SceneError> {
+    let fields = &scene.random_field;
+    for (k, spec) in fields.iter().enumerate() {
+        if !(spec.length.is_finite() && spec.length >= 0.0) {
+            return Err(SceneError::Invalid {
+                key: format!("random_field[{k}].length"),
+                value: spec.length.to_string(),
+                allowed: "the correlation length in m, finite and ≥ 0 (0: uncorrelated)".into(),
+            });
+        }
+        if spec.property != FieldProperty::E && scene.concrete.is_none() {
+            return Err(SceneError::Invalid {
+                key: format!("random_field[{k}].property"),
+                value: spec.property.name().into(),
+                allowed: "ft, Gf and fc need a [concrete] section; E works in any scene".into(),
+            });
+        }
+        if let Some(j) = fields[..k].iter().position(|f| f.property == spec.property) {
+            return Err(SceneError::Invalid {
+                key: format!("random_field[{k}].property"),
+                value: spec.property.name().into(),
+                allowed: format!(
+                    "one table per property; random_field[{j}] already draws {}",
+                    spec.property.name()
+                ),
+            });
+        }
+        if spec.tie_gf {
+            if spec.property != FieldProperty::Ft {
+                return Err(SceneError::Invalid {
+                    key: format!("random_field[{k}].tie_gf"),
+                    value: "true".into(),
+                    allowed: "only a table with property = \"ft\" can tie G_f to f't".into(),
+                });
+            }
+            if fields.iter().any(|f| f.property == FieldProperty::Gf) {
+                return Err(SceneError::Invalid {
+                    key: format!("random_field[{k}].tie_gf"),
+                    value: "true".into(),
+                    allowed: "false when a random_field table draws Gf itself".into(),
+                });
+            }
+        }
+        marginal(scene, k)?;
+    }
+    Ok(())
+}
+
+fn correlation(kind: CorrelationKind) -> Correlation {
+    match kind {
+        CorrelationKind::Exponential => Correlation::Exponential,
+        CorrelationKind::SquaredExponential => Correlation::SquaredExponential,
+    }
+}
+
+/// Sample every field of a resolved scene at the particles `x0`, over the body's bounding box
+/// `[lo, hi]`.
+pub fn sample(
+    scene: &Scene,
+    lo: Vector2<f64>,
+    hi: Vector2<f64>,
+    x0: &[Vector2<f64>],
+) -> Result<Vec<SampledField>, SceneError> {
+    let Some(scene_seed) = scene.effective_seed() else {
+        return Ok(vec![]);
+    };
+    let points: Vec<[f64; 2]> = x0.iter().map(|p| [p.x, p.y]).collect();
+    let mut out = Vec::with_capacity(scene.random_field.len());
+    for (k, spec) in scene.random_field.iter().enumerate() {
+        let marginal = marginal(scene, k)?;
+        let seed = field_seed(scene_seed, spec);
+        let field = GaussianField::new(
+            correlation(spec.correlation),
+            spec.length,
+            [lo.x, lo.y],
+            [hi.x, hi.y],
+            seed,
+        )
+        .map_err(|e| scene_error(k, e))?;
+        let g = field.sample(&points).map_err(|e| scene_error(k, e))?;
+        let values: Vec<f64> = g.iter().map(|&g| marginal.map(g)).collect();
+        let n = values.len().max(1) as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        let (target_mean, target_cov, modulus) = match marginal {
+            Marginal::Normal { mean, cov } | Marginal::LogNormal { mean, cov } => (mean, cov, None),
+            Marginal::Weibull { modulus, .. } => {
+                (marginal.mean(), weibull_cov(modulus), Some(modulus))
+            }
+        };
+        out.push(SampledField {
+            property: spec.property,
+            report: FieldReport {
+                property: spec.property,
+                correlation: spec.correlation,
+                length_m: spec.length,
+                marginal: spec.marginal,
+                mean: target_mean,
+                cov: target_cov,
+                modulus,
+                seed,
+                tie_gf: spec.tie_gf,
+                grid_spacing_m: field.spacing(),
+                clipped_fraction: field.embedding().map(|e| e.clipped_fraction),
+                sample_mean: mean,
+                sample_cov: var.sqrt() / mean,
+                sample_min: values.iter().copied().fold(f64::INFINITY, f64::min),
+                sample_max: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            },
+            values,
+        });
+    }
+    Ok(out)
+}
+
+/// CoV of a Weibull distribution of modulus m: √(Γ(1+2/m)/Γ(1+1/m)² − 1).
+fn weibull_cov(m: f64) -> f64 {
+    use statrs::function::gamma::gamma;
+    let g1 = gamma(1.0 + 1.0 / m);
+    (gamma(1.0 + 2.0 / m) / (g1 * g1) - 1.0).sqrt()
+}
+
+/// The values of `property` at every particle, if a field draws it.
+pub fn values_of(fields: &[SampledField], property: FieldProperty) -> Option<&[f64]> {
+    fields
+        .iter()
+        .find(|f| f.property == property)
+        .map(|f| f.values.as_slice())
+}
+
+/// The E factor E_i/E of every particle (none without an E field).
+pub fn stiffness_factors(fields: &[SampledField], e: f64) -> Option<Vec<f64>> {
+    values_of(fields, FieldProperty::E).map(|v| v.iter().map(|x| x / e).collect())
+}
+
+/// Each particle's concrete values, if any field varies them (see the module docs).
+pub fn local_properties(
+    fields: &[SampledField],
+    law: &ConcreteLaw,
+    n: usize,
+) -> Option<Vec<LocalProperties>> {
+    if fields.is_empty() {
+        return None;
+    }
+    let get = |p| values_of(fields, p);
+    let (e, ft, gf, fc) = (
+        get(FieldProperty::E),
+        get(FieldProperty::Ft),
+        get(FieldProperty::Gf),
+        get(FieldProperty::Fc),
+    );
+    let tie = fields
+        .iter()
+        .find(|f| f.property == FieldProperty::Ft && f.report.tie_gf);
+    Some(
+        (0..n)
+            .map(|i| {
+                let ft_i = ft.map_or(law.ft, |v| v[i]);
+                let gf_i = match (gf, tie) {
+                    (Some(v), _) => v[i],
+                    (None, Some(t)) => law.gf * ft_i / t.report.mean,
+                    (None, None) => law.gf,
+                };
+                law.local(
+                    e.map_or(law.e, |v| v[i]),
+                    ft_i,
+                    fc.map_or(law.fc, |v| v[i]),
+                    gf_i,
+                )
+            })
+            .collect(),
+    )
+}
