@@ -16,7 +16,7 @@ use toml::Value;
 
 /// The scene's sections: an error message names a key when it contains `section.` (or starts
 /// with `name =`), or carries the deserialiser's field or path (`field \`x\``, `in \`x.y\``).
-const SECTIONS: [&str; 9] = [
+const SECTIONS: [&str; 10] = [
     "body",
     "discretisation",
     "material",
@@ -26,12 +26,14 @@ const SECTIONS: [&str; 9] = [
     "damping",
     "solver",
     "output",
+    "random_field",
 ];
 
 fn names_a_key(msg: &str) -> bool {
     msg.contains("in `")
         || msg.contains("field `")
         || msg.starts_with("name =")
+        || msg.starts_with("seed =")
         || SECTIONS
             .iter()
             .any(|s| msg.contains(&format!("{s}.")) || msg.contains(&format!("{s}[")))
@@ -479,7 +481,13 @@ fn shipped() -> Vec<(String, Value)> {
             scene.discretisation.spacing * (estimated_particles(&scene) / 1500.0).sqrt().max(1.0);
         let mut v: Value = Value::Table(text.parse().unwrap());
         v["discretisation"]["spacing"] = Value::Float(spacing);
-        v["loading"]["end_periods"] = Value::Float(2.0);
+        v.as_table_mut()
+            .unwrap()
+            .entry("loading")
+            .or_insert(Value::Table(Default::default()))
+            .as_table_mut()
+            .unwrap()
+            .insert("end_periods".into(), Value::Float(2.0));
         let coarse = toml::to_string(&v).unwrap();
         Scene::from_toml_str(&coarse, &[]).unwrap();
         out.push((f.display().to_string(), v));
