@@ -20,7 +20,9 @@
 //! - Without ties, COD_c,i = 2·G_f,i/(f't,i·(α + γ)) at each particle, so a weak particle
 //!   softens more gently.
 
-use crate::material::random_field::{Correlation, FieldError, GaussianField, Marginal};
+use crate::material::random_field::{
+    splitmix64, weibull_cov, Correlation, FieldError, GaussianField, Marginal,
+};
 use crate::model::damage::{ConcreteLaw, LocalProperties};
 use crate::scene::{
     CorrelationKind, FieldProperty, MarginalKind, RandomFieldSpec, Scene, SceneError,
@@ -81,14 +83,6 @@ fn tag(p: FieldProperty) -> u64 {
         FieldProperty::Gf => 0x4766_5f66_6965_6c64,
         FieldProperty::Fc => 0x6663_5f66_6965_6c64,
     }
-}
-
-/// SplitMix64 finaliser.
-pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// The seed of a field: its own, else derived from the scene's seed and the property.
@@ -290,13 +284,6 @@ pub fn sample(
         });
     }
     Ok(out)
-}
-
-/// CoV of a Weibull distribution of modulus m: √(Γ(1+2/m)/Γ(1+1/m)² − 1).
-fn weibull_cov(m: f64) -> f64 {
-    use statrs::function::gamma::gamma;
-    let g1 = gamma(1.0 + 1.0 / m);
-    (gamma(1.0 + 2.0 / m) / (g1 * g1) - 1.0).sqrt()
 }
 
 /// The values of `property` at every particle, if a field draws it.

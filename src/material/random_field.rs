@@ -465,7 +465,9 @@ fn box_muller(u1: f64, u2: f64) -> (f64, f64) {
     (r * c, r * s)
 }
 
-fn splitmix(mut z: u64) -> u64 {
+/// SplitMix64 finaliser (Steele, Lea & Flood 2014): a bijective 64-bit mix, the hash of every
+/// seed derivation in sppm.
+pub fn splitmix64(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -476,8 +478,8 @@ fn splitmix(mut z: u64) -> u64 {
 fn hashed_normal(seed: u64, tag: u64, p: [f64; 2]) -> f64 {
     let qx = (p[0] / QUANTUM).round() as i64 as u64;
     let qy = (p[1] / QUANTUM).round() as i64 as u64;
-    let h = splitmix(splitmix(splitmix(seed ^ tag) ^ qx) ^ qy);
-    let u = |k: u64| ((splitmix(h ^ k) >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64);
+    let h = splitmix64(splitmix64(splitmix64(seed ^ tag) ^ qx) ^ qy);
+    let u = |k: u64| ((splitmix64(h ^ k) >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64);
     box_muller(u(1), u(2)).0
 }
 
