@@ -400,7 +400,10 @@ fn report(
     let sizes: Vec<SizeStats> = by_size
         .iter()
         .map(|(um, (values, failed, det))| {
-            let s = sample(values);
+            // summed in one order whatever the order of the rows (merged or not)
+            let mut values = values.clone();
+            values.sort_by(f64::total_cmp);
+            let s = sample(&values);
             SizeStats {
                 size_d_m: *um as f64 / 1e6,
                 n: s.n,
