@@ -41,13 +41,17 @@ pub enum StudyCommand {
         #[command(flatten)]
         common: StudyOptions,
     },
-    /// Monte Carlo statistical size effect: N realisations of the scene's random fields per
-    /// size (seed of realisation r of size D: a SplitMix64 hash of (S, D in µm, r)) plus one
-    /// deterministic run per size without the random fields; writes realisations.csv (a row
-    /// per finished run, resumed on a second invocation), deterministic.csv and, for the whole
-    /// study, size_effect.csv/json/svg (output/<scene>-montecarlo/). Size variant of size D
-    /// from a scene of size D0 and spacing s0: body.size = D, spacing = s0·min(1, D/D0), each
-    /// loaded group's displacement scaled by D/D0.
+    /// Realisations of the scene's random fields per specimen size and the statistical size
+    /// effect (output/<scene>-montecarlo/).
+    ///
+    /// N realisations per size, realisation r of size D with the seed hashed (SplitMix64) from
+    /// (S, D in µm, r), plus one deterministic run per size without the random fields. Writes
+    /// realisations.csv (a row per finished run; the same command resumes), deterministic.csv
+    /// and, for the whole study, size_effect.csv/json/svg (mean, std and CoV of
+    /// σN = P_max/(0.6·D·t) per size, Bažant type-1 and Weibull fits).
+    ///
+    /// The variant of size D from a scene of size D0 and spacing s0: body.size = D,
+    /// discretisation.spacing = s0·min(1, D/D0), each loaded group's displacement × D/D0.
     Montecarlo {
         scene: PathBuf,
         /// Realisations per size.
