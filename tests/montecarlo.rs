@@ -280,8 +280,9 @@ fn a_study_resumes_and_its_shards_merge_into_the_same_realisations() {
             (num(&s, "deterministic_sigma_N_Pa") / num(&det[&label], "sigma_N_Pa") - 1.0).abs()
                 < 1e-12
         );
-        // σN of a 0.05–0.1 m dog-bone with f't = 2.415 MPa: within 10% of f't (VALIDATION.md §D)
-        assert!((num(&s, "mean_sigma_N_Pa") / 2.415e6 - 1.0).abs() < 0.1);
+        // σN of a 0.05–0.1 m dog-bone with the mean f't = 2.415 MPa everywhere: within 10% of
+        // f't (VALIDATION.md §D; measured 4.8% and 7.2% below at this coarse spacing)
+        assert!((num(&s, "deterministic_sigma_N_Pa") / 2.415e6 - 1.0).abs() < 0.1);
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(full.join("size_effect.json")).unwrap())
