@@ -325,6 +325,15 @@ fn a_study_resumes_and_its_shards_merge_into_the_same_realisations() {
         base.join("bad").to_str().unwrap(),
     ]));
     assert!(e.contains("different studies"), "{e}");
+    // nor into the merged folder of this one
+    let e = failure(&sppm(&[
+        "study",
+        "merge",
+        other.to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]));
+    assert!(e.contains("holds another study"), "{e}");
     let _ = std::fs::remove_dir_all(&base);
 }
 

@@ -680,6 +680,19 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
     let scene_name = get("scene_name").as_str().unwrap_or("scene").to_string();
     let out =
         out.unwrap_or_else(|| PathBuf::from("output").join(format!("{scene_name}-montecarlo")));
+    if let Ok(text) = std::fs::read_to_string(out.join("study_inputs.json")) {
+        let old: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+        let mut old_unsharded = old.clone();
+        if let Some(o) = old_unsharded.as_object_mut() {
+            o.insert("shard".into(), serde_json::Value::Null);
+        }
+        if old_unsharded != inputs {
+            bail!(
+                "{} holds another study ({old}); the shards are from {inputs}: use another --out folder or remove it",
+                out.display()
+            );
+        }
+    }
     let scene = PathBuf::from(get("scene").as_str().unwrap_or_default());
     let overrides: Vec<String> = serde_json::from_value(get("overrides")).unwrap_or_default();
     let mut merged: [BTreeMap<String, RunRow>; 2] = [BTreeMap::new(), BTreeMap::new()];
