@@ -1,5 +1,6 @@
-//! The study plots: the overlay of the runs' force–displacement curves, and the peak force
-//! and dissipated energy against the lattice spacing with their extrapolated references.
+//! The study plots: the overlay of the runs' force–displacement curves, the peak force and
+//! dissipated energy against the lattice spacing with their extrapolated references, and the
+//! statistical size effect on log–log axes.
 
 use super::runner::RunResult;
 use crate::output::plots::{err, force_displacement_axes, padded};
@@ -137,7 +138,7 @@ pub fn convergence(title: &str, panels: &[Panel], path: &Path) -> anyhow::Result
 /// means (Bažant type-1, Weibull power law).
 pub fn size_effect(
     title: &str,
-    effect: &super::monte_carlo::SizeEffect,
+    effect: &super::size_effect_report::SizeEffect,
     path: &Path,
 ) -> anyhow::Result<()> {
     let mpa = 1e-6;
