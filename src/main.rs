@@ -58,7 +58,8 @@ enum Command {
         #[arg(long, default_value = "elastic")]
         model: String,
     },
-    /// Many runs of one scene: lattice objectivity or convergence with the spacing.
+    /// Many runs of one scene: lattice objectivity, convergence with the spacing, Monte Carlo
+    /// size effect (and the merge of its shards).
     Study {
         #[command(subcommand)]
         study: sppm::study::cli::StudyCommand,

@@ -1,7 +1,8 @@
-//! `sppm study objectivity|convergence`: the command-line face of the studies.
+//! `sppm study objectivity|convergence|montecarlo|merge`: the command-line face of the studies.
 
 use super::convergence::{convergence, ConvergenceArgs};
 use super::crack_path::CRACK_PATH_DAMAGE;
+use super::monte_carlo::{merge, monte_carlo, parse_shard, parse_sizes, MonteCarloArgs};
 use super::objectivity::{objectivity, ObjectivityArgs, DEFAULT_SEED};
 use super::runner::default_jobs;
 use anyhow::bail;
@@ -39,6 +40,49 @@ pub enum StudyCommand {
         spacings: String,
         #[command(flatten)]
         common: StudyOptions,
+    },
+    /// Realisations of the scene's random fields per specimen size and the statistical size
+    /// effect (output/<scene>-montecarlo/).
+    ///
+    /// N realisations per size, realisation r of size D with the seed hashed (SplitMix64) from
+    /// (S, D in µm, r), plus one deterministic run per size without the random fields. Writes
+    /// realisations.csv (a row per finished run; the same command resumes), deterministic.csv
+    /// and, for the whole study, size_effect.csv/json/svg (mean, std and CoV of
+    /// σN = P_max/(0.6·D·t) per size, Bažant type-1 and Weibull fits).
+    ///
+    /// The variant of size D from a scene of size D0 and spacing s0: body.size = D,
+    /// discretisation.spacing = s0·min(1, D/D0), each loaded group's displacement × D/D0.
+    Montecarlo {
+        scene: PathBuf,
+        /// Realisations per size.
+        #[arg(long)]
+        realisations: usize,
+        /// Study seed S (recorded in the CSV and size_effect.json).
+        #[arg(long)]
+        seed: u64,
+        /// Dog-bone sizes: letters A–F (D = 0.05, 0.1, 0.2, 0.4, 0.8, 1.6 m) or D in m,
+        /// comma-separated (default: the scene's own size; needs a dog-bone body).
+        #[arg(long)]
+        sizes: Option<String>,
+        /// Run only shard k of n: the runs whose index ≡ k−1 (mod n); no size-effect report
+        /// (combine the shards with `sppm study merge`).
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+        /// Write every output of every run (default: summary.json only).
+        #[arg(long)]
+        keep_outputs: bool,
+        #[command(flatten)]
+        common: StudyOptions,
+    },
+    /// Combine the shard folders of one Monte Carlo study: realisations.csv,
+    /// deterministic.csv and the size-effect report in --out.
+    Merge {
+        /// Shard folders.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Folder of the merged study (default: output/<scene name>-montecarlo).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
 }
 
@@ -142,6 +186,58 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 println!("wrote {}", report.dir.display());
             }
             Ok(status(report.completed, report.runs))
+        }
+        StudyCommand::Montecarlo {
+            scene,
+            realisations,
+            seed,
+            sizes,
+            shard,
+            keep_outputs,
+            common:
+                StudyOptions {
+                    set,
+                    out,
+                    jobs,
+                    quiet,
+                },
+        } => {
+            let report = monte_carlo(&MonteCarloArgs {
+                scene,
+                realisations,
+                seed,
+                sizes: sizes.as_deref().map(parse_sizes).transpose()?,
+                shard: shard.as_deref().map(parse_shard).transpose()?,
+                keep_outputs,
+                overrides: set,
+                out,
+                jobs: jobs.unwrap_or_else(default_jobs),
+                progress: !quiet,
+            })?;
+            match &report.size_effect {
+                Some(effect) => {
+                    for l in effect.lines() {
+                        println!("{l}");
+                    }
+                }
+                None => println!(
+                    "shard done: {} runs in {} (combine the shards with `sppm study merge`)",
+                    report.runs,
+                    report.dir.display()
+                ),
+            }
+            if !quiet {
+                println!("wrote {}", report.dir.display());
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        StudyCommand::Merge { dirs, out } => {
+            let effect = merge(&dirs, out)?;
+            for l in effect.lines() {
+                println!("{l}");
+            }
+            println!("wrote {}", effect.dir.display());
+            Ok(ExitCode::SUCCESS)
         }
     }
 }

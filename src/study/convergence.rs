@@ -165,6 +165,7 @@ pub fn convergence(args: &ConvergenceArgs) -> anyhow::Result<ConvergenceReport> 
         }),
         jobs: args.jobs,
         progress: args.progress,
+        outputs: super::runner::RunOutputs::All,
     };
     let results: Vec<RunResult> = study.run(&variants)?;
     let done: Vec<&RunRow> = results

@@ -5,16 +5,23 @@
 //! - [`objectivity`]: lattice rotations and offsets (peak-force spread, crack path).
 //! - [`convergence`]: lattice spacings (Richardson reference and observed order).
 //! - [`crack_path`], [`extrapolation`]: the pure functions the studies report with.
-//! - [`plots`]: the overlay and convergence plots; [`cli`]: the `sppm study` command.
+//! - [`plots`]: the overlay, convergence and size-effect plots; [`cli`]: the `sppm study`
+//!   command.
+//! - [`monte_carlo`]: realisations of the random fields per specimen size, shards and their
+//!   merge; [`size_effect`]: the statistics and the size-effect fits;
+//!   [`size_effect_report`]: the size-effect table, JSON and plot.
 //! - [`pareto`]: run time against error (`benchmarks/pareto.rs`).
 
 pub mod cli;
 pub mod convergence;
 pub mod crack_path;
 pub mod extrapolation;
+pub mod monte_carlo;
 pub mod objectivity;
 pub mod pareto;
 pub mod plots;
 pub mod runner;
+pub mod size_effect;
+pub mod size_effect_report;
 
 pub use runner::{RunResult, RunRow, Study, Variant};

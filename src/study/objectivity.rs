@@ -37,7 +37,7 @@ pub struct ObjectivityArgs {
 
 /// SplitMix64 (Steele, Lea and Flood 2014): a small, well-mixed generator, enough for
 /// uniform offsets and the same on every platform.
-fn splitmix64(mut z: u64) -> u64 {
+pub fn splitmix64(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -282,6 +282,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         }),
         jobs: args.jobs,
         progress: args.progress,
+        outputs: super::runner::RunOutputs::All,
     };
     let results = study.run(&variants)?;
 

@@ -50,6 +50,17 @@ pub struct Study<'a> {
     pub jobs: usize,
     /// Progress bar over runs.
     pub progress: bool,
+    /// What each run writes into `dir/label/`.
+    pub outputs: RunOutputs,
+}
+
+/// What each run of a study writes into its folder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunOutputs {
+    /// Every output the scene asks for (`output::write_all`).
+    All,
+    /// Only summary.json (Monte Carlo: hundreds of runs whose maps nobody reads).
+    Summary,
 }
 
 /// The summary columns every study CSV has, after the label and the tags.
@@ -211,6 +222,22 @@ impl Study<'_> {
         Ok(rows)
     }
 
+    /// Write `rows` as a fresh study CSV (replacing the file), in this study's layout.
+    pub fn write_rows(&self, rows: &[RunRow]) -> anyhow::Result<()> {
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("cannot create the study folder {}", self.dir.display()))?;
+        let path = self.csv_path();
+        let mut w = csv::Writer::from_path(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        w.write_record(self.header())?;
+        for r in rows {
+            w.write_record(self.record(r))?;
+        }
+        w.flush()
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(())
+    }
+
     /// Refuse a folder that holds rows of a study with other inputs; record ours.
     fn check_inputs(&self) -> anyhow::Result<()> {
         let path = self.dir.join("study_inputs.json");
@@ -262,7 +289,13 @@ impl Study<'_> {
         };
         match crate::run(scene, &opts) {
             Ok(outcome) => {
-                crate::output::write_all(&outcome, &self.dir.join(&v.label))?;
+                let dir = self.dir.join(&v.label);
+                match self.outputs {
+                    RunOutputs::All => {
+                        crate::output::write_all(&outcome, &dir)?;
+                    }
+                    RunOutputs::Summary => write_summary(&outcome, &dir)?,
+                }
                 let s = &outcome.summary;
                 row.particles = s.particles;
                 row.peak_force_n = s.peak_force_n;
@@ -427,6 +460,18 @@ impl Study<'_> {
             })
             .collect()
     }
+}
+
+/// Write only a run's summary.json into `dir`.
+fn write_summary(outcome: &Outcome, dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
+    let path = dir.join("summary.json");
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&outcome.summary)? + "\n",
+    )
+    .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// (displacement_m, force_N) of a run's force_displacement.csv.

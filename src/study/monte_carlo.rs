@@ -1,0 +1,619 @@
+//! The Monte Carlo study of the statistical size effect (MODEL.md §12, VALIDATION.md §D): N
+//! realisations of the scene's random fields per specimen size, each with its own seed, plus
+//! one deterministic run per size (the random fields removed: the mean properties
+//! everywhere), and the size-effect statistics and fits ([`super::size_effect`]).
+//!
+//! - **Sizes.** `--sizes` takes dog-bone letters A–F (D = 0.05, 0.1, 0.2, 0.4, 0.8, 1.6 m) or
+//!   sizes D in m. The size variant of size D from a scene of size D0 and spacing s0 has
+//!   `body.size = D`, `discretisation.spacing = s0·min(1, D/D0)` (the same particles per
+//!   width below the scene's size; the scene's spacing, which resolves the material's
+//!   correlation length, above it), and every loaded group's displacement scaled by D/D0 (so
+//!   that the peak falls at the same fraction of the load path).
+//! - **Seeds.** Realisation r (0-based) of size D has the seed
+//!   [`realisation_seed`]`(S, D, r)`, a SplitMix64 hash of the study seed S, D in µm (an
+//!   integer) and r: independent of the shard, the job count and the order of the runs. It is
+//!   set with `--set seed=...` and recorded in summary.json and the CSV.
+//! - **Shards.** The runs are listed slot-major: index = slot·(number of sizes) + size index,
+//!   slot 0 the deterministic run and slot r + 1 realisation r. Shard k/n runs the indices
+//!   ≡ k − 1 (mod n); adding realisations leaves every earlier run in its shard.
+//! - **Files.** `realisations.csv` (one row per realisation, appended as each finishes),
+//!   `deterministic.csv` (one row per size), then `size_effect.csv`, `size_effect.json` and
+//!   `size_effect.svg` ([`super::size_effect_report`]); `sppm study merge` combines shard
+//!   folders into the same files.
+
+use super::objectivity::splitmix64;
+use super::runner::{RunOutputs, RunRow, Study, Variant};
+use super::size_effect_report::{report, tag_f64, SizeEffect};
+use crate::run::Outcome;
+use crate::scene::BodySpec;
+use crate::Scene;
+use anyhow::{bail, Context};
+use serde_json::json;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The van Vliet dog-bone sizes A–F (VALIDATION.md §D): D in m.
+pub const DOGBONE_SIZES: [(char, f64); 6] = [
+    ('A', 0.05),
+    ('B', 0.1),
+    ('C', 0.2),
+    ('D', 0.4),
+    ('E', 0.8),
+    ('F', 1.6),
+];
+
+/// The rule that makes a size variant, as recorded in size_effect.json.
+pub const SPACING_RULE: &str = "body.size = D; discretisation.spacing = s0*min(1, D/D0); \
+     each loaded group's displacement *= D/D0 (D0, s0: the scene's size and spacing)";
+
+/// Shard k of n (1 ≤ k ≤ n).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub k: usize,
+    pub n: usize,
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.k, self.n)
+    }
+}
+
+/// Read `--shard k/n`.
+pub fn parse_shard(text: &str) -> anyhow::Result<Shard> {
+    let bad = || {
+        anyhow::anyhow!(
+            "--shard `{text}`: expected k/n with whole numbers 1 ≤ k ≤ n (e.g. --shard 3/8)"
+        )
+    };
+    let (k, n) = text.split_once('/').ok_or_else(bad)?;
+    let k: usize = k.trim().parse().map_err(|_| bad())?;
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    if k < 1 || k > n {
+        return Err(bad());
+    }
+    Ok(Shard { k, n })
+}
+
+/// Read `--sizes`: dog-bone letters A–F or sizes D in m (> 0), comma-separated; returned
+/// sorted and without repeats.
+pub fn parse_sizes(text: &str) -> anyhow::Result<Vec<f64>> {
+    let items: Vec<&str> = text
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .collect();
+    if items.is_empty() {
+        bail!("--sizes `{text}`: give dog-bone letters A–F or sizes D in m, comma-separated");
+    }
+    let mut sizes = Vec::new();
+    for s in items {
+        let letter = DOGBONE_SIZES
+            .iter()
+            .find(|(c, _)| s.len() == 1 && s.eq_ignore_ascii_case(&c.to_string()));
+        let d = match letter {
+            Some((_, d)) => *d,
+            None => match s.parse::<f64>() {
+                Ok(d) if d.is_finite() && d > 0.0 => d,
+                _ => bail!(
+                    "--sizes `{text}`: `{s}` is neither a dog-bone letter A–F nor a size D in m > 0"
+                ),
+            },
+        };
+        sizes.push(d);
+    }
+    sizes.sort_by(f64::total_cmp);
+    sizes.dedup_by(|a, b| size_um(*a) == size_um(*b));
+    Ok(sizes)
+}
+
+/// A size in whole µm (the key of a size in seeds, labels and merges).
+pub fn size_um(d: f64) -> u64 {
+    (d * 1e6).round() as u64
+}
+
+/// The seed of realisation `r` (0-based) of size `d` (m) in a study of seed `study_seed`: a
+/// SplitMix64 hash of (S, D in µm, r), kept below 2^63 so that it is a TOML integer.
+pub fn realisation_seed(study_seed: u64, d: f64, r: usize) -> u64 {
+    splitmix64(splitmix64(splitmix64(study_seed) ^ size_um(d)) ^ r as u64) >> 1
+}
+
+/// One run of the study: a size (index into the size list) and a realisation (`None`: the
+/// deterministic run).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Item {
+    pub size: usize,
+    pub realisation: Option<usize>,
+}
+
+/// The runs of `shard` (all runs without one) among `sizes` sizes × (1 deterministic +
+/// `realisations`), listed slot-major (module docs).
+pub fn shard_items(sizes: usize, realisations: usize, shard: Option<Shard>) -> Vec<Item> {
+    let mut out = Vec::new();
+    for slot in 0..=realisations {
+        for size in 0..sizes {
+            let index = slot * sizes + size;
+            if shard.is_none_or(|s| index % s.n == s.k - 1) {
+                out.push(Item {
+                    size,
+                    realisation: slot.checked_sub(1),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The study's inputs.
+#[derive(Clone, Debug)]
+pub struct MonteCarloArgs {
+    pub scene: PathBuf,
+    pub realisations: usize,
+    pub seed: u64,
+    /// Sizes D in m; `None`: the scene's own size.
+    pub sizes: Option<Vec<f64>>,
+    pub shard: Option<Shard>,
+    /// Write every output of every run (default: summary.json only).
+    pub keep_outputs: bool,
+    pub overrides: Vec<String>,
+    pub out: Option<PathBuf>,
+    pub jobs: usize,
+    pub progress: bool,
+}
+
+/// The nominal strength σN = P_max/(b·D·t) of a run of `scene`: b = 0.6 and D the size of a
+/// dog-bone (σN is then the mean stress over the neck), else b = 1 and D the body's width.
+pub fn nominal_strength(scene: &Scene, peak_force_n: f64) -> f64 {
+    let (d, b) = nominal_size(scene);
+    peak_force_n.abs() / (b * d * scene.material.thickness)
+}
+
+/// (D, b) of [`nominal_strength`].
+fn nominal_size(scene: &Scene) -> (f64, f64) {
+    match scene.body {
+        BodySpec::Dogbone { size } => (size, 0.6),
+        _ => {
+            let (lo, hi) = scene.shape().bounding_box();
+            (hi.x - lo.x, 1.0)
+        }
+    }
+}
+
+fn body_name(body: &BodySpec) -> &'static str {
+    match body {
+        BodySpec::Rectangle { .. } => "rectangle",
+        BodySpec::Polygon { .. } => "polygon",
+        BodySpec::Disc { .. } => "disc",
+        BodySpec::Dogbone { .. } => "dogbone",
+        BodySpec::NotchedBeam { .. } => "notched_beam",
+    }
+}
+
+/// The label of a size: D in mm, e.g. `D50mm`.
+fn size_label(d: f64) -> String {
+    format!("D{}mm", size_um(d) as f64 / 1000.0)
+}
+
+/// A float as a TOML value.
+fn toml_float(v: f64) -> String {
+    format!("{v:?}")
+}
+
+/// The overrides that make the size variant of size `d` from `base` ([`SPACING_RULE`]).
+pub fn size_overrides(base: &Scene, d: f64) -> Vec<String> {
+    let BodySpec::Dogbone { size: d0 } = base.body else {
+        return vec![];
+    };
+    let ratio = d / d0;
+    let mut o = vec![
+        format!("body.size={}", toml_float(d)),
+        format!(
+            "discretisation.spacing={}",
+            toml_float(base.discretisation.spacing * ratio.min(1.0))
+        ),
+    ];
+    for (i, g) in base.groups.iter().enumerate() {
+        if let Some(load) = &g.load {
+            o.push(format!(
+                "groups.{i}.load.displacement={}",
+                toml_float(load.delta() * ratio)
+            ));
+        }
+    }
+    o
+}
+
+/// FNV-1a of bytes (a fingerprint of the scene file in study_inputs.json).
+fn fnv1a(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h = (h ^ *b as u64).wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+const TAGS: [&str; 3] = ["size_D_m", "realisation", "seed"];
+const DET_TAGS: [&str; 2] = ["size_D_m", "seed"];
+const METRICS: [&str; 1] = ["sigma_N_Pa"];
+
+fn sigma_metric(o: &Outcome) -> Vec<f64> {
+    vec![nominal_strength(&o.scene, o.summary.peak_force_n)]
+}
+
+/// The two study tables of a folder: realisations and deterministic runs.
+fn studies<'a>(
+    scene: &Path,
+    overrides: &[String],
+    dir: &Path,
+    inputs: &serde_json::Value,
+    jobs: usize,
+    progress: bool,
+    outputs: RunOutputs,
+) -> (Study<'a>, Study<'a>) {
+    let make = |csv: &str, tags: &[&str]| Study {
+        scene: scene.to_path_buf(),
+        base_overrides: overrides.to_vec(),
+        dir: dir.to_path_buf(),
+        csv_name: csv.into(),
+        tag_columns: tags.iter().map(|s| s.to_string()).collect(),
+        metric_columns: METRICS.iter().map(|s| s.to_string()).collect(),
+        metrics: &sigma_metric,
+        inputs: inputs.clone(),
+        jobs,
+        progress,
+        outputs,
+    };
+    (
+        make("realisations.csv", &TAGS),
+        make("deterministic.csv", &DET_TAGS),
+    )
+}
+
+/// What a Monte Carlo command did: the size effect (`None` for a shard) and the counts.
+pub struct MonteCarloReport {
+    pub dir: PathBuf,
+    pub runs: usize,
+    pub size_effect: Option<SizeEffect>,
+}
+
+/// Run the study (or one shard of it); without a shard, write the size-effect report.
+pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
+    if args.realisations == 0 {
+        bail!("--realisations 0: at least 1 realisation per size is needed");
+    }
+    let base = Scene::from_file(&args.scene, &args.overrides)?;
+    for (k, f) in base.random_field.iter().enumerate() {
+        if let Some(s) = f.seed {
+            bail!(
+                "random_field[{k}].seed = {s} (property {}): with its own seed every realisation \
+                 would draw the same field; remove it so that the field's seed derives from the \
+                 scene's seed, which the Monte Carlo study sets per realisation",
+                f.property.name()
+            );
+        }
+    }
+    if base.random_field.is_empty() {
+        eprintln!(
+            "warning: {} has no [[random_field]]: every realisation of a size is the same run",
+            args.scene.display()
+        );
+    }
+    let sizes = match &args.sizes {
+        Some(s) => {
+            if !matches!(base.body, BodySpec::Dogbone { .. }) {
+                bail!(
+                    "--sizes needs a dog-bone body ([body] shape = \"dogbone\"); the scene's body is `{}` (leave --sizes out to run the scene's own size)",
+                    body_name(&base.body)
+                );
+            }
+            s.clone()
+        }
+        None => vec![nominal_size(&base).0],
+    };
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("output").join(format!("{}-montecarlo", base.name())));
+    let text = std::fs::read(&args.scene)
+        .with_context(|| format!("cannot read {}", args.scene.display()))?;
+    let d0 = nominal_size(&base).0;
+    let inputs = json!({
+        "study": "montecarlo",
+        "scene": args.scene.display().to_string(),
+        "scene_name": base.name(),
+        "scene_fnv1a": fnv1a(&text),
+        "overrides": args.overrides,
+        "seed": args.seed,
+        "sizes_m": sizes,
+        "scene_size_m": d0,
+        "scene_spacing_m": base.discretisation.spacing,
+        "shard": args.shard.map(|s| s.to_string()),
+    });
+    let outputs = if args.keep_outputs {
+        RunOutputs::All
+    } else {
+        RunOutputs::Summary
+    };
+    let (mc, det) = studies(
+        &args.scene,
+        &args.overrides,
+        &dir,
+        &inputs,
+        args.jobs,
+        args.progress,
+        outputs,
+    );
+    let mut items = shard_items(sizes.len(), args.realisations, args.shard);
+    // largest first: the long runs start early and the last ones to finish are short
+    items.sort_by(|a, b| {
+        sizes[b.size]
+            .total_cmp(&sizes[a.size])
+            .then(a.realisation.cmp(&b.realisation))
+    });
+    let mut det_variants = Vec::new();
+    let mut mc_variants = Vec::new();
+    for it in &items {
+        let d = sizes[it.size];
+        let mut overrides = size_overrides(&base, d);
+        match it.realisation {
+            None => {
+                // the mean properties everywhere: no random field, no seed
+                overrides.push("random_field=[]".into());
+                det_variants.push(Variant {
+                    label: format!("{}-det", size_label(d)),
+                    overrides,
+                    tags: vec![d.to_string(), String::new()],
+                });
+            }
+            Some(r) => {
+                let seed = realisation_seed(args.seed, d, r);
+                overrides.push(format!("seed={seed}"));
+                mc_variants.push(Variant {
+                    label: format!("{}-r{r}", size_label(d)),
+                    overrides,
+                    tags: vec![d.to_string(), r.to_string(), seed.to_string()],
+                });
+            }
+        }
+    }
+    let det_results = det.run(&det_variants)?;
+    let mc_results = mc.run(&mc_variants)?;
+    let runs = det_results.len() + mc_results.len();
+    if args.shard.is_some() {
+        return Ok(MonteCarloReport {
+            dir,
+            runs,
+            size_effect: None,
+        });
+    }
+    let rows = |r: Vec<super::RunResult>| r.into_iter().map(|r| r.row).collect::<Vec<_>>();
+    let meta = json!({
+        "scene": args.scene.display().to_string(),
+        "scene_name": base.name(),
+        "seed": args.seed,
+        "realisations": args.realisations,
+        "spacing_rule": SPACING_RULE,
+        "scene_size_m": d0,
+        "scene_spacing_m": base.discretisation.spacing,
+        "overrides": args.overrides,
+    });
+    let title = format!(
+        "{}: size effect, {} realisations",
+        base.name(),
+        args.realisations
+    );
+    let effect = report(&dir, &rows(mc_results), &rows(det_results), meta, &title)?;
+    Ok(MonteCarloReport {
+        dir,
+        runs,
+        size_effect: Some(effect),
+    })
+}
+
+/// Combine shard folders of one study into `out` (default: output/<scene>-montecarlo/):
+/// realisations.csv, deterministic.csv, study_inputs.json (without the shard) and the
+/// size-effect report. Duplicate runs with the same seed are kept once; the same run with
+/// different seeds, or shards of different studies, are an error.
+pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffect> {
+    if dirs.is_empty() {
+        bail!("merge: give at least one shard folder");
+    }
+    let mut common: Option<(serde_json::Value, PathBuf)> = None;
+    for d in dirs {
+        let path = d.join("study_inputs.json");
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!(
+                "cannot read {} (is {} a Monte Carlo study folder?)",
+                path.display(),
+                d.display()
+            )
+        })?;
+        let mut v: serde_json::Value = serde_json::from_str(&text)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        if v.get("study").and_then(|s| s.as_str()) != Some("montecarlo") {
+            bail!("{} is not from a Monte Carlo study", path.display());
+        }
+        if let Some(o) = v.as_object_mut() {
+            o.insert("shard".into(), serde_json::Value::Null);
+        }
+        match &common {
+            None => common = Some((v, path)),
+            Some((c, first)) if *c != v => bail!(
+                "{} and {} are from different studies (their study_inputs.json differ beyond the shard): {c} against {v}",
+                first.display(),
+                path.display()
+            ),
+            _ => {}
+        }
+    }
+    let (inputs, _) = common.unwrap();
+    let get = |k: &str| inputs.get(k).cloned().unwrap_or(serde_json::Value::Null);
+    let scene_name = get("scene_name").as_str().unwrap_or("scene").to_string();
+    let out =
+        out.unwrap_or_else(|| PathBuf::from("output").join(format!("{scene_name}-montecarlo")));
+    if let Ok(text) = std::fs::read_to_string(out.join("study_inputs.json")) {
+        let old: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+        let mut old_unsharded = old.clone();
+        if let Some(o) = old_unsharded.as_object_mut() {
+            o.insert("shard".into(), serde_json::Value::Null);
+        }
+        if old_unsharded != inputs {
+            bail!(
+                "{} holds another study ({old}); the shards are from {inputs}: use another --out folder or remove it",
+                out.display()
+            );
+        }
+    }
+    let scene = PathBuf::from(get("scene").as_str().unwrap_or_default());
+    let overrides: Vec<String> = serde_json::from_value(get("overrides")).unwrap_or_default();
+    let mut merged: [BTreeMap<String, RunRow>; 2] = [BTreeMap::new(), BTreeMap::new()];
+    for d in dirs {
+        let (mc, det) = studies(
+            &scene,
+            &overrides,
+            d,
+            &inputs,
+            1,
+            false,
+            RunOutputs::Summary,
+        );
+        for (k, (study, seed_col)) in [(&mc, 2), (&det, 1)].into_iter().enumerate() {
+            for row in study.read_rows()? {
+                match merged[k].get(&row.label) {
+                    Some(old) if old.tags[seed_col] != row.tags[seed_col] => bail!(
+                        "run {} appears with seed {} and with seed {} (in {}): the shards do not belong together",
+                        row.label,
+                        old.tags[seed_col],
+                        row.tags[seed_col],
+                        d.display()
+                    ),
+                    Some(_) => {}
+                    None => {
+                        merged[k].insert(row.label.clone(), row);
+                    }
+                }
+            }
+        }
+    }
+    let [mc_rows, det_rows] = merged.map(|m| m.into_values().collect::<Vec<_>>());
+    let (mc, det) = studies(
+        &scene,
+        &overrides,
+        &out,
+        &inputs,
+        1,
+        false,
+        RunOutputs::Summary,
+    );
+    mc.write_rows(&mc_rows)?;
+    det.write_rows(&det_rows)?;
+    std::fs::write(
+        out.join("study_inputs.json"),
+        serde_json::to_string_pretty(&inputs)? + "\n",
+    )
+    .with_context(|| format!("cannot write {}", out.join("study_inputs.json").display()))?;
+    let per_size = mc_rows
+        .iter()
+        .fold(BTreeMap::<u64, usize>::new(), |mut m, r| {
+            *m.entry(size_um(tag_f64(r, 0))).or_default() += 1;
+            m
+        });
+    let realisations = per_size.values().copied().max().unwrap_or(0);
+    let meta = json!({
+        "scene": get("scene"),
+        "scene_name": scene_name,
+        "seed": get("seed"),
+        "realisations": realisations,
+        "spacing_rule": SPACING_RULE,
+        "scene_size_m": get("scene_size_m"),
+        "scene_spacing_m": get("scene_spacing_m"),
+        "overrides": get("overrides"),
+        "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
+    });
+    let title = format!("{scene_name}: size effect, {realisations} realisations");
+    report(&out, &mc_rows, &det_rows, meta, &title)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_take_letters_and_metres() {
+        assert_eq!(
+            parse_sizes("F,a,0.2,B").unwrap(),
+            vec![0.05, 0.1, 0.2, 1.6],
+            "sorted, repeats (B = 0.1) kept once"
+        );
+        let e = parse_sizes("A,G").unwrap_err().to_string();
+        assert!(e.contains("--sizes") && e.contains("`G`"), "{e}");
+        assert!(parse_sizes("0.1,-0.2").is_err());
+        assert!(parse_sizes(" , ").is_err());
+    }
+
+    #[test]
+    fn shard_needs_one_le_k_le_n() {
+        assert_eq!(parse_shard("2/5").unwrap(), Shard { k: 2, n: 5 });
+        for bad in ["0/2", "3/2", "1", "a/2", "1/0", "-1/2"] {
+            let e = parse_shard(bad).unwrap_err().to_string();
+            assert!(e.contains("--shard") && e.contains(bad), "{e}");
+        }
+    }
+
+    #[test]
+    fn seeds_depend_on_study_seed_size_and_realisation_only() {
+        let s = realisation_seed(7, 0.1, 3);
+        assert_eq!(s, realisation_seed(7, 0.1 + 1e-9, 3), "same µm, same seed");
+        assert!(s < 1 << 63, "a TOML integer");
+        let mut all = std::collections::HashSet::new();
+        for seed in [7, 8] {
+            for d in [0.05, 0.1, 0.2] {
+                for r in 0..50 {
+                    assert!(all.insert(realisation_seed(seed, d, r)));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn shards_are_disjoint_and_cover_the_runs() {
+        let all = shard_items(6, 7, None);
+        assert_eq!(all.len(), 6 * 8);
+        for n in 1..=5 {
+            let mut union: Vec<Item> = (1..=n)
+                .flat_map(|k| shard_items(6, 7, Some(Shard { k, n })))
+                .collect();
+            let len = union.len();
+            union.sort();
+            union.dedup();
+            assert_eq!(union.len(), len, "shards of {n} overlap");
+            let mut want = all.clone();
+            want.sort();
+            assert_eq!(union, want, "shards of {n} do not cover the runs");
+        }
+        // adding realisations keeps every earlier run in its shard
+        let s = Some(Shard { k: 2, n: 3 });
+        let small = shard_items(6, 3, s);
+        let large = shard_items(6, 9, s);
+        assert!(small.iter().all(|i| large.contains(i)));
+    }
+
+    #[test]
+    fn size_variant_follows_the_spacing_rule() {
+        let base = Scene::from_file(Path::new("lattices/dogbone_D.toml"), &[]).unwrap();
+        let o = size_overrides(&base, 0.1);
+        assert_eq!(o[0], "body.size=0.1");
+        assert_eq!(o[1], "discretisation.spacing=0.002", "8 mm × 0.1/0.4");
+        assert_eq!(o[2], "groups.2.load.displacement=0.000125");
+        let o = size_overrides(&base, 1.6);
+        assert_eq!(
+            o[1], "discretisation.spacing=0.008",
+            "the scene's spacing above D0"
+        );
+        assert_eq!(o[2], "groups.2.load.displacement=0.002");
+        let s = Scene::from_file(Path::new("lattices/dogbone_D.toml"), &o).unwrap();
+        assert!(matches!(s.body, BodySpec::Dogbone { size } if size == 1.6));
+        let sigma = nominal_strength(&s, 1.0e5);
+        assert!((sigma - 1.0e5 / (0.6 * 1.6 * 0.1)).abs() < 1e-6);
+    }
+}
