@@ -75,24 +75,40 @@ pub struct Probe {
 }
 
 /// Stops a run once it has passed its peak (`loading.stop_after_peak`): the probe force,
-/// taken along the loading direction, has fallen below `fraction` × its largest value and a
-/// particle has failed. The failed particle keeps the early ramp, where the force is near
-/// zero and dynamic ripples can dip below any fraction of it, from stopping the run. Records
-/// up to the stop are those of the full run, so its peak is the same bit for bit.
+/// taken along the loading direction, has fallen below `fraction` × its largest value, and
+/// (explicit runs) a particle has failed. The failed particle keeps the early ramp of an
+/// explicit run, where the force is near zero and dynamic ripples can dip below any fraction
+/// of it, from stopping the run. Relaxation records are converged (quasi-static) states with
+/// no ripples, so they stop on the force alone: a fine lattice whose particles need a large
+/// strain to fail (COD_c/(crack_band·L0)) would otherwise run long after the peak (dog-bone
+/// A at L0 = 1 mm: peak at 1.1 s, stop at 6.9 s). Records up to the stop are those of the full
+/// run, so its peak is the same bit for bit.
 #[derive(Clone, Copy, Debug)]
 pub struct PeakStop {
     fraction: Option<f64>,
     /// +1 or −1: the loading direction of the probe.
     sign: f64,
     peak: f64,
+    /// Also wait for a failed particle (explicit runs).
+    need_failure: bool,
 }
 
 impl PeakStop {
+    /// For an explicit run (waits for a failed particle).
     pub fn new(fraction: Option<f64>, probe: &Probe) -> Self {
         PeakStop {
             fraction,
             sign: if probe.amplitude < 0.0 { -1.0 } else { 1.0 },
             peak: 0.0,
+            need_failure: true,
+        }
+    }
+
+    /// For a relaxation run (the force alone decides).
+    pub fn quasi_static(fraction: Option<f64>, probe: &Probe) -> Self {
+        PeakStop {
+            need_failure: false,
+            ..Self::new(fraction, probe)
         }
     }
 
@@ -107,7 +123,9 @@ impl PeakStop {
         };
         let f = self.sign * rec.force_n;
         self.peak = self.peak.max(f);
-        self.peak > 0.0 && f < fraction * self.peak && sim.has_failed_particle()
+        self.peak > 0.0
+            && f < fraction * self.peak
+            && (!self.need_failure || sim.has_failed_particle())
     }
 }
 

@@ -301,7 +301,7 @@ pub fn relax<const D: usize, const K: usize>(
 ) -> Relaxed {
     let mut damping = AdaptiveDamping::new(sim);
     let mut predictor = Predictor::new(sim.x0.len());
-    let mut stop = PeakStop::new(s.stop_after_peak, probe);
+    let mut stop = PeakStop::quasi_static(s.stop_after_peak, probe);
     let mut r_prev = 0.0;
     let mut out = Relaxed {
         records: Vec::with_capacity(s.increments + 1),

@@ -7,8 +7,19 @@
 //!   sizes D in m. The size variant of size D from a scene of size D0 and spacing s0 has
 //!   `body.size = D`, `discretisation.spacing = s0·min(1, D/D0)` (the same particles per
 //!   width below the scene's size; the scene's spacing, which resolves the material's
-//!   correlation length, above it), and every loaded group's displacement scaled by D/D0 (so
-//!   that the peak falls at the same fraction of the load path).
+//!   correlation length, above it), every loaded group's displacement scaled by √(D/D0), and,
+//!   with the relaxation solver, `solver.max_iterations` scaled by max(1, D/D0).
+//!   - The displacement: the elastic elongation at the peak grows with D, but the crack opening
+//!     needed to fall to `stop_after_peak` × the peak does not (it is a fraction of COD_c), so
+//!     scaling by D/D0 left the small sizes short of it (dog-bone A from the 0.1 mm of D: the
+//!     force never fell to 80% within 12.5 µm) and by 1 resolves the large sizes' peaks coarsely.
+//!     √(D/D0) puts the peak at 25–60% of the load path from A to F.
+//!   - The iterations: increments in which damage grows do not converge and stop at
+//!     max_iterations, and a crack needs about as many iterations to run as there are particles
+//!     across, which grows as D/D0 above D0 (fixed spacing). With a fixed limit the peak of the
+//!     large sizes came out high: dog-bone F, one realisation, 181.6 / 167.9 / 165.0 kN at 500 /
+//!     2000 / 4000 iterations (E: 92.5 / 90.65 / 90.2 kN at 500 / 1000 / 2000; D: 50.52 / 50.36 kN
+//!     at 500 / 2000).
 //! - **Seeds.** Realisation r (0-based) of size D has the seed
 //!   [`realisation_seed`]`(S, D, r)`, a SplitMix64 hash of the study seed S, D in µm (an
 //!   integer) and r: independent of the shard, the job count and the order of the runs. It is
@@ -21,9 +32,9 @@
 //!   `size_effect.svg` ([`super::size_effect_report`]); `sppm study merge` combines shard
 //!   folders into the same files.
 
-use super::objectivity::splitmix64;
 use super::runner::{RunOutputs, RunRow, Study, Variant};
 use super::size_effect_report::{report, tag_f64, SizeEffect};
+use crate::material::random_field::splitmix64;
 use crate::run::Outcome;
 use crate::scene::BodySpec;
 use crate::Scene;
@@ -44,7 +55,8 @@ pub const DOGBONE_SIZES: [(char, f64); 6] = [
 
 /// The rule that makes a size variant, as recorded in size_effect.json.
 pub const SPACING_RULE: &str = "body.size = D; discretisation.spacing = s0*min(1, D/D0); \
-     each loaded group's displacement *= D/D0 (D0, s0: the scene's size and spacing)";
+     each loaded group's displacement *= sqrt(D/D0); relaxation: solver.max_iterations *= \
+     max(1, D/D0) (D0, s0: the scene's size and spacing)";
 
 /// Shard k of n (1 ≤ k ≤ n).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -216,9 +228,13 @@ pub fn size_overrides(base: &Scene, d: f64) -> Vec<String> {
         if let Some(load) = &g.load {
             o.push(format!(
                 "groups.{i}.load.displacement={}",
-                toml_float(load.delta() * ratio)
+                toml_float(load.delta() * ratio.sqrt())
             ));
         }
+    }
+    if base.solver.method == crate::scene::SolverMethod::Relaxation {
+        let m = (base.solver.max_iterations as f64 * ratio.max(1.0)).round() as usize;
+        o.push(format!("solver.max_iterations={m}"));
     }
     o
 }
@@ -412,13 +428,17 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
 
 /// Combine shard folders of one study into `out` (default: output/<scene>-montecarlo/):
 /// realisations.csv, deterministic.csv, study_inputs.json (without the shard) and the
-/// size-effect report. Duplicate runs with the same seed are kept once; the same run with
-/// different seeds, or shards of different studies, are an error.
+/// size-effect report. Folders of the same study at other sizes (another `--sizes`) combine
+/// too: a realisation's seed depends on (S, D, r) only, so e.g. the small sizes at N = 100 and
+/// the largest at fewer realisations make one report. Duplicate runs with the same seed are
+/// kept once; the same run with different seeds, or folders of different studies (scene,
+/// overrides, seed), are an error.
 pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffect> {
     if dirs.is_empty() {
         bail!("merge: give at least one shard folder");
     }
     let mut common: Option<(serde_json::Value, PathBuf)> = None;
+    let mut sizes: Vec<f64> = Vec::new();
     for d in dirs {
         let path = d.join("study_inputs.json");
         let text = std::fs::read_to_string(&path).with_context(|| {
@@ -433,8 +453,12 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
         if v.get("study").and_then(|s| s.as_str()) != Some("montecarlo") {
             bail!("{} is not from a Monte Carlo study", path.display());
         }
+        // shards, and studies of other sizes (seeds depend on (S, D, r) only), combine
         if let Some(o) = v.as_object_mut() {
             o.insert("shard".into(), serde_json::Value::Null);
+            if let Some(list) = o.insert("sizes_m".into(), serde_json::Value::Null) {
+                sizes.extend(serde_json::from_value::<Vec<f64>>(list).unwrap_or_default());
+            }
         }
         match &common {
             None => common = Some((v, path)),
@@ -446,7 +470,10 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
             _ => {}
         }
     }
-    let (inputs, _) = common.unwrap();
+    let (mut inputs, _) = common.unwrap();
+    sizes.sort_by(f64::total_cmp);
+    sizes.dedup_by(|a, b| size_um(*a) == size_um(*b));
+    inputs["sizes_m"] = json!(sizes);
     let get = |k: &str| inputs.get(k).cloned().unwrap_or(serde_json::Value::Null);
     let scene_name = get("scene_name").as_str().unwrap_or("scene").to_string();
     let out =
@@ -604,16 +631,25 @@ mod tests {
         let o = size_overrides(&base, 0.1);
         assert_eq!(o[0], "body.size=0.1");
         assert_eq!(o[1], "discretisation.spacing=0.002", "8 mm × 0.1/0.4");
-        assert_eq!(o[2], "groups.2.load.displacement=0.000125");
+        assert_eq!(
+            o[2], "groups.2.load.displacement=0.00025",
+            "0.5 mm × √(1/4)"
+        );
         let o = size_overrides(&base, 1.6);
         assert_eq!(
             o[1], "discretisation.spacing=0.008",
             "the scene's spacing above D0"
         );
-        assert_eq!(o[2], "groups.2.load.displacement=0.002");
+        assert_eq!(o[2], "groups.2.load.displacement=0.001", "0.5 mm × √4");
+        assert_eq!(o.len(), 3, "explicit: max_iterations is not set");
         let s = Scene::from_file(Path::new("lattices/dogbone_D.toml"), &o).unwrap();
         assert!(matches!(s.body, BodySpec::Dogbone { size } if size == 1.6));
         let sigma = nominal_strength(&s, 1.0e5);
         assert!((sigma - 1.0e5 / (0.6 * 1.6 * 0.1)).abs() < 1e-6);
+        let relax = Scene::from_file(Path::new("lattices/dogbone_montecarlo.toml"), &[]).unwrap();
+        let o = size_overrides(&relax, 1.6);
+        assert_eq!(o[3], "solver.max_iterations=2000", "500 × 1.6/0.4");
+        let o = size_overrides(&relax, 0.05);
+        assert_eq!(o[3], "solver.max_iterations=500", "not below the scene's");
     }
 }

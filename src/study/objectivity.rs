@@ -10,6 +10,7 @@
 
 use super::crack_path::{crack_core, crack_path, mean_axis_deg};
 use super::runner::{RunResult, Study, Variant};
+use crate::material::random_field::splitmix64;
 use crate::run::Outcome;
 use crate::Scene;
 use anyhow::bail;
@@ -33,15 +34,6 @@ pub struct ObjectivityArgs {
     pub out: Option<PathBuf>,
     pub jobs: usize,
     pub progress: bool,
-}
-
-/// SplitMix64 (Steele, Lea and Flood 2014): a small, well-mixed generator, enough for
-/// uniform offsets and the same on every platform.
-pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// The fractional position (u, v) in [0, 1)² of random offset `k` (k ≥ 1) for `seed`.
