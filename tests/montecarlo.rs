@@ -307,6 +307,46 @@ fn a_study_resumes_and_its_shards_merge_into_the_same_realisations() {
     let svg = std::fs::read_to_string(full.join("size_effect.svg")).unwrap();
     assert!(svg.contains("specimen size D (m)") && svg.contains("Monte Carlo mean"));
 
+    // studies of other sizes merge too (a seed depends on (S, D, r) only): 0.05 m at N = 3
+    // and 0.1 m at N = 2 give the unsharded study's rows for those runs
+    let small = base.join("small");
+    let large = base.join("large");
+    for (dir, size, n) in [(&small, "0.05", "3"), (&large, "0.1", "2")] {
+        ok(&sppm(&[
+            "study",
+            "montecarlo",
+            scene.to_str().unwrap(),
+            "--realisations",
+            n,
+            "--seed",
+            "42",
+            "--sizes",
+            size,
+            "--jobs",
+            "2",
+            "--quiet",
+            "--out",
+            dir.to_str().unwrap(),
+        ]));
+    }
+    let both = base.join("both");
+    ok(&sppm(&[
+        "study",
+        "merge",
+        small.to_str().unwrap(),
+        large.to_str().unwrap(),
+        "--out",
+        both.to_str().unwrap(),
+    ]));
+    let combined = key(rows(&both.join("realisations.csv")));
+    let unsharded = key(rows(&full.join("realisations.csv")));
+    assert_eq!(combined.len(), 5);
+    for (label, v) in &combined {
+        assert_eq!(&unsharded[label], v, "{label}");
+    }
+    let ns: Vec<String> = table(&both).iter().map(|r| r["n"].clone()).collect();
+    assert_eq!(ns, ["3", "2"]);
+
     // shards of another study (other seed) do not merge with these
     let other = base.join("other");
     ok(&sppm(&[
