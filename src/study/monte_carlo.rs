@@ -557,7 +557,12 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
         "overrides": get("overrides"),
         "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
     });
-    let title = format!("{scene_name}: size effect, {realisations} realisations");
+    let fewest = per_size.values().copied().min().unwrap_or(0);
+    let title = if fewest == realisations {
+        format!("{scene_name}: size effect, {realisations} realisations")
+    } else {
+        format!("{scene_name}: size effect, {fewest}–{realisations} realisations per size")
+    };
     report(&out, &mc_rows, &det_rows, meta, &title)
 }
 
