@@ -6,6 +6,7 @@
 //! The scene is a coarse dog-bone (D0 = 0.1 m at L0 = 8 mm, 223 particles, relaxation with a
 //! stop after the peak: about 0.4 s a run) for the mechanics of the study, not for physics.
 
+mod common;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -87,17 +88,7 @@ fn failure(o: &Output) -> String {
 type Row = HashMap<String, String>;
 
 fn rows(path: &Path) -> Vec<Row> {
-    let mut rd = csv::Reader::from_path(path).unwrap();
-    let h = rd.headers().unwrap().clone();
-    rd.records()
-        .map(|r| {
-            let r = r.unwrap();
-            h.iter()
-                .zip(r.iter())
-                .map(|(k, v)| (k.to_string(), v.to_string()))
-                .collect()
-        })
-        .collect()
+    common::csv_rows(path)
 }
 
 fn by_label(rows: &[Row]) -> BTreeMap<String, Row> {

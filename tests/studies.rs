@@ -3,6 +3,7 @@
 //! interrupted study, clear errors for bad arguments, and the objectivity of the tension block
 //! against VALIDATION.md §B.
 
+mod common;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -33,17 +34,7 @@ fn text(o: &Output) -> (String, String) {
 
 /// The rows of a study CSV as maps from column to value.
 fn rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
-    let mut rd = csv::Reader::from_path(path).unwrap();
-    let h = rd.headers().unwrap().clone();
-    rd.records()
-        .map(|r| {
-            let r = r.unwrap();
-            h.iter()
-                .zip(r.iter())
-                .map(|(k, v)| (k.to_string(), v.to_string()))
-                .collect()
-        })
-        .collect()
+    common::csv_rows(path)
 }
 
 fn num(row: &std::collections::HashMap<String, String>, key: &str) -> f64 {

@@ -103,13 +103,17 @@ pub struct StudyOptions {
     quiet: bool,
 }
 
-/// A comma-separated list of numbers; `option` names it in the message.
-pub fn parse_list(option: &str, text: &str) -> anyhow::Result<Vec<f64>> {
-    let items: Vec<&str> = text
-        .split(',')
+/// The non-empty, trimmed items of a comma-separated option value.
+pub fn comma_items(text: &str) -> Vec<&str> {
+    text.split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty())
-        .collect();
+        .collect()
+}
+
+/// A comma-separated list of numbers; `option` names it in the message.
+pub fn parse_list(option: &str, text: &str) -> anyhow::Result<Vec<f64>> {
+    let items = comma_items(text);
     if items.is_empty() {
         bail!("{option} `{text}`: give a comma-separated list of at least one number");
     }

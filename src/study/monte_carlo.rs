@@ -90,11 +90,7 @@ pub fn parse_shard(text: &str) -> anyhow::Result<Shard> {
 /// Read `--sizes`: dog-bone letters A–F or sizes D in m (> 0), comma-separated; returned
 /// sorted and without repeats.
 pub fn parse_sizes(text: &str) -> anyhow::Result<Vec<f64>> {
-    let items: Vec<&str> = text
-        .split(',')
-        .map(str::trim)
-        .filter(|s| !s.is_empty())
-        .collect();
+    let items = super::cli::comma_items(text);
     if items.is_empty() {
         bail!("--sizes `{text}`: give dog-bone letters A–F or sizes D in m, comma-separated");
     }

@@ -169,3 +169,18 @@ records = 400
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     Scene::from_toml_str(&text, &o).unwrap()
 }
+
+/// The rows of a CSV file as maps from column to value.
+pub fn csv_rows(path: &std::path::Path) -> Vec<std::collections::HashMap<String, String>> {
+    let mut rd = csv::Reader::from_path(path).unwrap();
+    let h = rd.headers().unwrap().clone();
+    rd.records()
+        .map(|r| {
+            let r = r.unwrap();
+            h.iter()
+                .zip(r.iter())
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
