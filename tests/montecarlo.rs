@@ -7,9 +7,10 @@
 //! stop after the peak: about 0.4 s a run) for the mechanics of the study, not for physics.
 
 mod common;
+use common::sppm;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 const SCENE: &str = r#"
 name = "tiny_dogbone"
@@ -61,14 +62,6 @@ fn scene_file(dir: &Path) -> PathBuf {
     let p = dir.join("tiny_dogbone.toml");
     std::fs::write(&p, SCENE).unwrap();
     p
-}
-
-fn sppm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sppm"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("sppm runs")
 }
 
 fn ok(o: &Output) -> String {

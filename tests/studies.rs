@@ -4,16 +4,9 @@
 //! against VALIDATION.md §B.
 
 mod common;
+use common::sppm;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn sppm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sppm"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("sppm runs")
-}
+use std::process::Output;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("sppm-study-{name}-{}", std::process::id()));
