@@ -1,6 +1,6 @@
 #!/bin/bash
 # The Monte Carlo size-effect study of benchmarks/RESULTS.md ("Random fields and the Monte Carlo
-# size effect (issue 5)"): dog-bones A–E × 100 realisations and F × N_F (default 25), two jobs
+# size effect (issue 5)"): dog-bones A–E × 100 realisations and F × N_F (default 40), two jobs
 # at a time, then one report over A–F and the realisations per hour per size.
 #
 #   bash benchmarks/montecarlo.sh [N_F]
@@ -9,7 +9,7 @@
 # output/mc-AE/realisations.csv and output/mc-F/realisations.csv as it finishes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-NF=${1:-25}
+NF=${1:-40}
 cargo build --release --quiet
 B=target/release/sppm
 S=lattices/dogbone_montecarlo.toml
