@@ -8,6 +8,21 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
+/// The legend box of sppm's plots: translucent white, framed in black, at `position`.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> anyhow::Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
 /// A plotting error as an anyhow error (plotters' errors are generic over the backend).
 pub fn err<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow::anyhow!("plotting failed: {e}")
@@ -116,12 +131,8 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
             .map_err(err)?
             .label(format!("peak {:.4} kN", o.summary.peak_force_n * 1e-3))
             .legend(|(x, y)| Circle::new((x, y), 5, RED.filled()));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        // plotters' default place
+        draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     }
     root.present().map_err(err)?;
     Ok(())
