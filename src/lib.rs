@@ -6,7 +6,9 @@
 
 pub mod bench;
 pub mod discretise;
+pub mod fsio;
 pub mod geometry;
+pub mod limits;
 pub mod material;
 pub mod model;
 pub mod output;

@@ -62,13 +62,7 @@ pub struct Prepared {
     pub probe: Option<(String, Probe)>,
 }
 
-/// Available memory of this machine in bytes (MemAvailable), if known.
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
+pub use crate::limits::available_memory;
 
 /// Particles the body will hold (area / cell area), known before anything is allocated.
 pub fn estimated_particles(scene: &Scene) -> f64 {
