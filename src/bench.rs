@@ -25,6 +25,17 @@ pub struct BenchResult {
     pub seconds: f64,
 }
 
+/// Bytes per particle a benchmark of `kernel` allocates: the run's arrays
+/// ([`crate::discretise::bytes_per_particle`]) and, with damage, the concrete state (strain
+/// fit, committed and trial damage and plastic stretch: about 60 f64 per particle).
+pub fn bytes_per_particle(kernel: KernelSet) -> usize {
+    let base = crate::discretise::bytes_per_particle(2, 6);
+    match kernel {
+        KernelSet::Elastic => base,
+        _ => base + 60 * 8 + 6 * 8,
+    }
+}
+
 /// Time `steps` steps of `kernel` (bond dampers on, as in the shipped scenes) on a square
 /// block of about `particles` particles on `threads` threads. The tension and full kernels
 /// run the Table 1 concrete of 002, strained to 90% of f't/E so that every particle

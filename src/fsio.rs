@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 /// An input/output operation on `path` failed (unwritable folder, full disk, …).
 #[derive(Debug, thiserror::Error)]
-#[error("cannot {action} {}: {source}", path.display())]
+#[error("cannot {action} {}", path.display())]
 pub struct IoFailure {
     pub action: &'static str,
     pub path: PathBuf,

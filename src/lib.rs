@@ -5,6 +5,7 @@
 //! [`model`] → [`solver`] → [`output`]. A run is [`run::run`]; the CLI is a thin caller.
 
 pub mod bench;
+pub mod console;
 pub mod discretise;
 pub mod fsio;
 pub mod geometry;

@@ -34,7 +34,3 @@ pub fn check_count(key: &str, count: f64, bytes_each: f64, what: &str) -> anyhow
     }
     Ok(())
 }
-
-/// Largest scene file sppm reads (a scene is a few kB of TOML; this bounds a mistaken
-/// `/dev/zero` or a data file given as the scene).
-pub const MAX_SCENE_BYTES: u64 = 1 << 20;

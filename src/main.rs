@@ -3,7 +3,8 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use sppm::run::{estimated_memory, prepare, RunOptions};
-use sppm::Scene;
+use sppm::fsio::{FolderBusy, IoFailure};
+use sppm::{say, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -66,13 +67,32 @@ enum Command {
     },
 }
 
+/// Exit statuses (README, docs/reliability.md).
+mod exit {
+    /// Bad input: a malformed scene, an impossible parameter or count.
+    pub const BAD_INPUT: u8 = 2;
+    /// A run that went unstable or whose increments did not converge.
+    pub const RUN_FAILED: u8 = 3;
+    /// An output could not be written (unwritable folder, full disk).
+    pub const IO_FAILURE: u8 = 4;
+    /// The output or study folder is in use by another sppm process.
+    pub const FOLDER_BUSY: u8 = 5;
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match dispatch(cli) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::from(2)
+            let code = if e.chain().any(|c| c.is::<FolderBusy>()) {
+                exit::FOLDER_BUSY
+            } else if e.chain().any(|c| c.is::<IoFailure>()) {
+                exit::IO_FAILURE
+            } else {
+                exit::BAD_INPUT
+            };
+            ExitCode::from(code)
         }
     }
 }
@@ -87,7 +107,12 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             threads,
         } => {
             let sc = Scene::from_file(&scene, &set)?;
+            if threads == Some(0) {
+                anyhow::bail!("--threads 0: at least 1 worker thread is needed");
+            }
             let dir = out.unwrap_or_else(|| PathBuf::from("output").join(sc.name()));
+            // the folder is checked, created and locked before any compute is spent
+            let _folder = sppm::output::RunFolder::open(&dir)?;
             let outcome = sppm::run(
                 &sc,
                 &RunOptions {
@@ -98,21 +123,34 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             let files = sppm::output::write_all(&outcome, &dir)?;
             let s = &outcome.summary;
             if !quiet {
-                println!(
+                say!(
                     "{}: {} particles, {} bonds, {} steps of {:.4e} s (T1 = {:.4e} s) in {:.2} s on {} threads",
                     s.scene, s.particles, s.bonds, s.steps, s.dt_s, s.fundamental_period_s, s.wall_time_s, s.threads
                 );
-                println!(
+                say!(
                     "peak force {:.6e} N at {:.6e} m; max kinetic/internal energy {:.3e}",
                     s.peak_force_n, s.displacement_at_peak_m, s.max_kinetic_to_internal_energy
                 );
                 for f in &files {
-                    println!("wrote {}", f.display());
+                    say!("wrote {}", f.display());
+                }
+            }
+            if let (Some(k), Some(r), false) = (
+                s.unconverged_increments,
+                s.max_final_residual,
+                outcome.failed(),
+            ) {
+                if k > 0 {
+                    eprintln!(
+                        "warning: {k} of {} load increments stopped at solver.max_iterations with an out-of-balance force up to {r:.3e} × the reactions (accepted by solver.max_residual = {:e})",
+                        s.increments.unwrap_or(0),
+                        sc.solver.max_residual.unwrap_or(sc.solver.tolerance)
+                    );
                 }
             }
             if outcome.failed() {
                 eprintln!("error: {}", s.message.clone().unwrap_or_default());
-                return Ok(ExitCode::from(3));
+                return Ok(ExitCode::from(exit::RUN_FAILED));
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -129,10 +167,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 sim.advance(None);
             }
             let per_step = t.elapsed().as_secs_f64() / calib as f64;
-            println!("scene            {}", sc.name());
-            println!("particles        {}", p.model.particles.len());
-            println!("bonds            {}", p.model.particles.bonds());
-            println!(
+            say!("scene            {}", sc.name());
+            say!("particles        {}", p.model.particles.len());
+            say!("bonds            {}", p.model.particles.bonds());
+            say!(
                 "groups           {}",
                 p.model
                     .groups
@@ -141,38 +179,38 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
-            println!("fundamental T1   {:.6e} s", p.fundamental.period);
-            println!("stable dt        {:.6e} s", p.stable.dt_stable);
-            println!("time step dt     {:.6e} s", p.dt);
+            say!("fundamental T1   {:.6e} s", p.fundamental.period);
+            say!("stable dt        {:.6e} s", p.stable.dt_stable);
+            say!("time step dt     {:.6e} s", p.dt);
             let threads = rayon::current_num_threads();
             let solver = &sc.solver;
             if solver.method == sppm::scene::SolverMethod::Relaxation {
                 // the iterations per increment are known only once it has converged
                 let most = solver.increments * solver.max_iterations;
-                println!(
+                say!(
                     "solver           relaxation: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
                     solver.increments, solver.max_iterations, solver.tolerance
                 );
-                println!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-                println!(
+                say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+                say!(
                     "run time (est.)  at most {:.1} s on {threads} threads ({most} iterations); elastic increments converge in 1–10",
                     per_step * most as f64
                 );
             } else {
-                println!("t_end            {:.6e} s", p.t_end);
-                println!("steps            {}", p.steps);
-                println!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-                println!(
+                say!("t_end            {:.6e} s", p.t_end);
+                say!("steps            {}", p.steps);
+                say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+                say!(
                     "run time (est.)  {:.1} s on {threads} threads",
                     per_step * p.steps as f64
                 );
             }
-            println!(
+            say!(
                 "surface corr.    {} of {} boundary particles",
                 p.model.surface.corrected, p.model.surface.boundary_particles
             );
             for d in &sc.derived {
-                println!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);
+                say!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -196,10 +234,20 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 ),
             };
             anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
+            sppm::limits::check_count(
+                "--particles",
+                particles as f64,
+                sppm::bench::bytes_per_particle(kernel) as f64,
+                "particles",
+            )?;
             anyhow::ensure!(threads >= 1, "--threads {threads}: at least 1");
+            anyhow::ensure!(
+                threads <= 4096,
+                "--threads {threads}: at most 4096 worker threads"
+            );
             let r = sppm::bench::bench(particles, steps.max(1), threads, kernel)
                 .context("benchmark failed")?;
-            println!("{}", serde_json::to_string(&r)?);
+            say!("{}", serde_json::to_string(&r)?);
             Ok(ExitCode::SUCCESS)
         }
         Command::Study { study } => sppm::study::cli::dispatch(study),

@@ -138,8 +138,15 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
         if members.is_empty() {
             return Err(RunError::Scene(crate::scene::SceneError::Invalid {
                 key: format!("groups.{}.select", g.name),
-                value: format!("{:?}", g.select),
-                allowed: "a selection that contains at least one particle".into(),
+                value: g.select.scene_text(),
+                allowed: format!(
+                    "a selection that contains at least one particle; the body's {} particles lie in x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m at this spacing, rotation and offset",
+                    particles.len(),
+                    particles.x0.iter().map(|x| x.x).fold(f64::INFINITY, f64::min),
+                    particles.x0.iter().map(|x| x.x).fold(f64::NEG_INFINITY, f64::max),
+                    particles.x0.iter().map(|x| x.y).fold(f64::INFINITY, f64::min),
+                    particles.x0.iter().map(|x| x.y).fold(f64::NEG_INFINITY, f64::max),
+                ),
             }));
         }
         let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
@@ -229,6 +236,7 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
     let (lo, hi) = shape.bounding_box();
     let pad = Vector2::repeat(1e-6 * shape.size().max(1.0));
     let fields = properties::sample(scene, lo - pad, hi + pad, &particles.x0)?;
+    properties::check_strengths(scene, &fields)?;
     if let Some(f) = properties::stiffness_factors(&fields, m.youngs_modulus()) {
         for i in 0..n {
             a[i] *= f[i];
@@ -607,6 +615,7 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
             wall_s: &wall_s,
             wall,
             threads,
+            steps_done: sim.step,
             failure: failure.as_ref().map(|e| e.to_string()),
         },
         damage.as_deref(),
@@ -702,6 +711,8 @@ struct Finished<'a> {
     wall_s: &'a [f64],
     wall: f64,
     threads: usize,
+    /// Kernel steps taken (the step an unstable run stopped at, not only the last record).
+    steps_done: usize,
     failure: Option<String>,
 }
 
@@ -716,7 +727,26 @@ fn summarise(p: &Prepared, run: &Finished, damage: Option<&[ParticleDamage]>) ->
         threads,
         ..
     } = *run;
+    let s = &p.model.scene.solver;
+    let accepted = s.max_residual.unwrap_or(s.tolerance);
+    let unconverged = match (report.unconverged_increments, report.max_final_residual) {
+        (Some(k), Some(r)) if k > 0 && r > accepted => Some(format!(
+            "{k} of {} load increments stopped at solver.max_iterations = {} with an out-of-balance force up to {r:.3e} × the reactions, above {} = {accepted:e}: the forces and the crack path are not the quasi-static answer. Raise solver.max_iterations or solver.increments, or accept the residual with solver.max_residual ≥ {r:.2e}",
+            report.increments.unwrap_or(0),
+            s.max_iterations,
+            if s.max_residual.is_some() { "solver.max_residual" } else { "solver.tolerance" },
+        )),
+        _ => None,
+    };
     let failure = run.failure.clone();
+    let status = if failure.is_some() {
+        "unstable"
+    } else if unconverged.is_some() {
+        "unconverged"
+    } else {
+        "completed"
+    };
+    let failure = failure.or(unconverged);
     let sign = p
         .probe
         .as_ref()
@@ -754,15 +784,11 @@ fn summarise(p: &Prepared, run: &Finished, damage: Option<&[ParticleDamage]>) ->
     Summary {
         scene: p.model.scene.name().to_string(),
         description: p.model.scene.description.clone(),
-        status: if failure.is_some() {
-            "unstable".into()
-        } else {
-            "completed".into()
-        },
+        status: status.into(),
         message: failure,
         particles: p.model.particles.len(),
         bonds: p.model.particles.bonds(),
-        steps: records.last().map(|r| r.step + 1).unwrap_or(0),
+        steps: run.steps_done,
         dt_s: p.dt,
         dt_stable_s: p.stable.dt_stable,
         safety: p.dt / p.stable.dt_stable,

@@ -53,6 +53,47 @@ fn boundary_height(shape: &Shape2, n: Vector2<f64>, t: Vector2<f64>, s: f64) -> 
     None
 }
 
+/// Add to `chosen` the `rows` outermost layers facing `n` (at heights x·n ≥ `floor`): layer 1
+/// is the particles that have no neighbour in any lattice direction e with e·n > ½ (the
+/// directions that point out through the edge), layer k+1 those whose neighbours in those
+/// directions all lie in layers ≤ k.
+fn peel_layers<const K: usize>(
+    p: &Particles<2, K>,
+    n: Vector2<f64>,
+    rows: u32,
+    floor: f64,
+    chosen: &mut [bool],
+) {
+    // the lattice directions, read off a particle with every bond
+    let Some(bulk) = (0..p.len()).find(|&i| p.bond_count(i) == K) else {
+        return;
+    };
+    let outward: Vec<Vector2<f64>> = p.neighbours[bulk]
+        .iter()
+        .map(|&j| (p.x0[j as usize] - p.x0[bulk]).normalize())
+        .filter(|e| e.dot(&n) > 0.5 + 1e-9)
+        .collect();
+    let mut layer = vec![0u32; p.len()]; // 0: not peeled yet
+    for k in 1..=rows {
+        let next: Vec<usize> = (0..p.len())
+            .filter(|&i| layer[i] == 0 && p.x0[i].dot(&n) >= floor)
+            .filter(|&i| {
+                outward.iter().all(|e| {
+                    p.neighbours[i].iter().all(|&j| {
+                        j == super::NONE
+                            || layer[j as usize] != 0
+                            || (p.x0[j as usize] - p.x0[i]).normalize().dot(e) < 0.99
+                    })
+                })
+            })
+            .collect();
+        for i in next {
+            layer[i] = k;
+            chosen[i] = true;
+        }
+    }
+}
+
 /// Select the members of a group. Empty selections are reported by the caller.
 pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shape2) -> Vec<u32> {
     let pitch = 0.5 * 3f64.sqrt() * p.spacing;
@@ -86,7 +127,17 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
                     .map(|x| x.dot(&n))
                     .fold(f64::NEG_INFINITY, f64::max);
             let cut = hmax - (*rows as f64 - 0.5) * pitch;
-            pick(&|x| x.dot(&n) >= cut)
+            let mut chosen: Vec<bool> = p.x0.iter().map(|x| x.dot(&n) >= cut).collect();
+            // Rows parallel to the edge exist only where the edge runs along a lattice
+            // direction. Elsewhere (a vertical edge of the unrotated lattice: a zigzag of
+            // particles L0/2 apart in depth) the depth cut alone takes every other lattice
+            // line; peel `rows` layers off the surface as well, so that every lattice line
+            // reaching the edge gives its `rows` outermost particles.
+            peel_layers(p, n, *rows, hmax - (*rows as f64 + 0.5) * p.spacing, &mut chosen);
+            (0..p.len())
+                .filter(|&i| chosen[i])
+                .map(|i| i as u32)
+                .collect()
         }
         Selection::Strip {
             edge,
@@ -112,6 +163,54 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
 mod tests {
     use super::*;
     use crate::discretise::hex::HexLattice;
+
+    #[test]
+    fn edge_rows_on_a_vertical_edge_take_one_particle_of_every_lattice_row() {
+        // the unrotated lattice's rows are horizontal: along the left and right edges the
+        // outermost particles zigzag L0/2 apart; `rows = r` takes r of every row
+        let s = Shape2::Rectangle {
+            origin: Vector2::zeros(),
+            width: 0.1,
+            height: 0.05,
+        };
+        for width in [0.1, 0.1037] {
+            let s = match s {
+                Shape2::Rectangle { origin, height, .. } => Shape2::Rectangle {
+                    origin,
+                    width,
+                    height,
+                },
+                _ => unreachable!(),
+            };
+            let lat = HexLattice {
+                spacing: 0.005,
+                rotation_deg: 0.0,
+                offset: Vector2::zeros(),
+                thickness: 0.05,
+            };
+            let p = lat.fill(&s);
+            let mut ys: Vec<i64> = p.x0.iter().map(|x| (x.y / 1e-6).round() as i64).collect();
+            ys.sort();
+            ys.dedup();
+            for edge in [Edge::Left, Edge::Right] {
+                for rows in [1u32, 2] {
+                    let m = select(&Selection::Edge { edge, rows }, &p, &s);
+                    assert_eq!(
+                        m.len(),
+                        rows as usize * ys.len(),
+                        "{edge:?} rows = {rows}, width {width}"
+                    );
+                    for y in &ys {
+                        let in_row = m
+                            .iter()
+                            .filter(|&&i| (p.x0[i as usize].y / 1e-6).round() as i64 == *y)
+                            .count();
+                        assert_eq!(in_row, rows as usize, "{edge:?} rows = {rows}, row y = {y} µm");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn edge_rows_pick_whole_rows() {

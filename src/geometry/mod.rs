@@ -179,24 +179,53 @@ fn distance_to_polygon(v: &[Vector2<f64>], p: &Vector2<f64>) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Whether two polygon edges (other than neighbours) cross: used to refuse self-intersecting
-/// polygons.
+/// Whether a polygon is not simple: two edges (other than neighbours) cross, touch or
+/// overlap, a vertex repeats, or an edge turns straight back along the one before (an
+/// outline traversed twice is all of these). Used to refuse such bodies.
 pub fn polygon_self_intersects(v: &[Vector2<f64>]) -> bool {
     let n = v.len();
+    let size = v
+        .iter()
+        .flat_map(|p| [p.x.abs(), p.y.abs()])
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    // cross products below this are zero (collinear) to round-off
+    let eps = 1e-12 * size * size;
     let cross = |o: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>| {
         (a - o).x * (b - o).y - (a - o).y * (b - o).x
     };
+    let sign = |c: f64| if c > eps { 1 } else if c < -eps { -1 } else { 0 };
+    // q lies on the segment a–b (given that the three are collinear)
+    let within = |a: Vector2<f64>, b: Vector2<f64>, q: Vector2<f64>| {
+        q.x >= a.x.min(b.x) - eps.sqrt()
+            && q.x <= a.x.max(b.x) + eps.sqrt()
+            && q.y >= a.y.min(b.y) - eps.sqrt()
+            && q.y <= a.y.max(b.y) + eps.sqrt()
+    };
     for i in 0..n {
+        // a vertex visited twice, or an edge that turns straight back on the one before
+        let (a, b, c) = (v[i], v[(i + 1) % n], v[(i + 2) % n]);
+        if (b - a).norm() <= eps.sqrt()
+            || (sign(cross(a, b, c)) == 0 && (b - a).dot(&(c - b)) < 0.0)
+        {
+            return true;
+        }
         for j in i + 1..n {
             if j == i + 1 || (i == 0 && j == n - 1) {
                 continue;
             }
             let (p1, p2, q1, q2) = (v[i], v[(i + 1) % n], v[j], v[(j + 1) % n]);
-            let d1 = cross(q1, q2, p1);
-            let d2 = cross(q1, q2, p2);
-            let d3 = cross(p1, p2, q1);
-            let d4 = cross(p1, p2, q2);
-            if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+            let d1 = sign(cross(q1, q2, p1));
+            let d2 = sign(cross(q1, q2, p2));
+            let d3 = sign(cross(p1, p2, q1));
+            let d4 = sign(cross(p1, p2, q2));
+            // a proper crossing, or two edges that touch or overlap
+            if (d1 * d2 < 0 && d3 * d4 < 0)
+                || (d1 == 0 && within(q1, q2, p1))
+                || (d2 == 0 && within(q1, q2, p2))
+                || (d3 == 0 && within(p1, p2, q1))
+                || (d4 == 0 && within(p1, p2, q2))
+            {
                 return true;
             }
         }
@@ -207,6 +236,31 @@ pub fn polygon_self_intersects(v: &[Vector2<f64>]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn polygons_that_cross_touch_or_retrace_themselves_are_not_simple() {
+        let p = |v: &[[f64; 2]]| -> Vec<Vector2<f64>> {
+            v.iter().map(|a| Vector2::new(a[0], a[1])).collect()
+        };
+        let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        assert!(!polygon_self_intersects(&p(&square)));
+        let l_shape = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]];
+        assert!(!polygon_self_intersects(&p(&l_shape)));
+        // the square's outline traversed twice
+        let twice: Vec<[f64; 2]> = square.iter().chain(square.iter()).copied().collect();
+        assert!(polygon_self_intersects(&p(&twice)));
+        // a bow tie (proper crossing)
+        assert!(polygon_self_intersects(&p(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])));
+        // a vertex on another edge, and an edge that doubles back
+        assert!(polygon_self_intersects(&p(&[[0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [1.0, 1.0]])));
+        assert!(polygon_self_intersects(&p(&[
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 2.0],
+            [1.0, 0.0],
+            [0.0, 2.0]
+        ])));
+    }
 
     #[test]
     fn dogbone_widths_match_the_specification() {

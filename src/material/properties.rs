@@ -337,3 +337,51 @@ pub fn local_properties(
             .collect(),
     )
 }
+
+/// Refuse fields that make a particle's tensile strength reach its compressive strength
+/// (f't,i ≥ f'c,i: no concrete, and the two-spring law's criteria would cross), naming the
+/// field whose spread did it.
+pub fn check_strengths(scene: &Scene, fields: &[SampledField]) -> Result<(), SceneError> {
+    let Some(law) = scene.concrete_law() else {
+        return Ok(());
+    };
+    let ft = values_of(fields, FieldProperty::Ft);
+    let fc = values_of(fields, FieldProperty::Fc);
+    if ft.is_none() && fc.is_none() {
+        return Ok(());
+    }
+    let n = ft.or(fc).map_or(0, |v| v.len());
+    let bad: Vec<usize> = (0..n)
+        .filter(|&i| ft.map_or(law.ft, |v| v[i]) >= fc.map_or(law.fc, |v| v[i]))
+        .collect();
+    let Some(&first) = bad.first() else {
+        return Ok(());
+    };
+    let k = scene
+        .random_field
+        .iter()
+        .position(|f| f.property == FieldProperty::Ft)
+        .or_else(|| {
+            scene
+                .random_field
+                .iter()
+                .position(|f| f.property == FieldProperty::Fc)
+        })
+        .unwrap_or(0);
+    let spec = &scene.random_field[k];
+    let (key, value) = match (spec.cov, spec.modulus) {
+        (Some(c), _) => ("cov", c.to_string()),
+        (None, Some(m)) => ("modulus", m.to_string()),
+        _ => ("cov", "(default)".to_string()),
+    };
+    Err(SceneError::Invalid {
+        key: format!("random_field[{k}].{key}"),
+        value,
+        allowed: format!(
+            "a spread for which f't stays below f'c at every particle: at {} of {n} particles f't ≥ f'c (e.g. particle {first}: f't = {:.3} MPa, f'c = {:.3} MPa); lower the spread or the mean",
+            bad.len(),
+            ft.map_or(law.ft, |v| v[first]) * 1e-6,
+            fc.map_or(law.fc, |v| v[first]) * 1e-6
+        ),
+    })
+}

@@ -7,51 +7,126 @@ pub mod fields;
 pub mod plots;
 pub mod vtk;
 
+use crate::fsio;
 use crate::run::Outcome;
-use anyhow::Context;
 use std::path::{Path, PathBuf};
 
+/// The files of a run that sppm owns in its folder (besides `random_field_<property>.svg`):
+/// a new run into the folder replaces them all, so the folder only ever holds one run.
+pub const RUN_FILES: [&str; 7] = [
+    "summary.json",
+    "force_displacement.csv",
+    "particles.csv",
+    "force_displacement.svg",
+    "crack_map.svg",
+    "particle_map.svg",
+    "particles.vtk",
+];
+
+/// Is `name` a file that a run writes into its folder?
+pub fn is_run_file(name: &str) -> bool {
+    RUN_FILES.contains(&name) || (name.starts_with("random_field_") && name.ends_with(".svg"))
+}
+
+/// A run's output folder, checked, created and locked before the run starts (so an
+/// unwritable folder costs no compute, and two runs never write into one folder at once).
+pub struct RunFolder {
+    pub dir: PathBuf,
+    _lock: fsio::FolderLock,
+}
+
+impl RunFolder {
+    /// Create `dir`, check that files can be written in it, and lock it.
+    pub fn open(dir: &Path) -> anyhow::Result<RunFolder> {
+        fsio::ensure_writable_folder(dir)?;
+        let lock = fsio::FolderLock::acquire(dir)?;
+        Ok(RunFolder {
+            dir: dir.to_path_buf(),
+            _lock: lock,
+        })
+    }
+}
+
 /// Write every output the scene asks for into `dir`; returns the files written.
+///
+/// Each file is written under a temporary name and renamed into place ([`fsio`]), so no
+/// output is ever seen half-written. The earlier run's summary.json goes first and the new
+/// one is written last: a folder whose summary.json is missing holds an unfinished write.
+/// Files of an earlier run that this run does not write (a crack map, a random-field map,
+/// the VTK file) are removed, so the folder holds one run only.
 pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
-    let mut files = Vec::new();
+    std::fs::create_dir_all(dir).map_err(|e| fsio::IoFailure::new("create the folder", dir, e))?;
     let summary = dir.join("summary.json");
-    std::fs::write(
-        &summary,
-        serde_json::to_string_pretty(&outcome.summary)? + "\n",
-    )
-    .with_context(|| format!("cannot write {}", summary.display()))?;
-    files.push(summary);
-    let f = dir.join("force_displacement.csv");
-    csv::write_records(&outcome.records, &f)?;
-    files.push(f);
-    let f = dir.join("particles.csv");
-    csv::write_particles(outcome, &f)?;
-    files.push(f);
-    let f = dir.join("force_displacement.svg");
-    plots::force_displacement(outcome, &f)?;
-    files.push(f);
+    match std::fs::remove_file(&summary) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(fsio::IoFailure::new("remove the old", &summary, e).into()),
+    }
+    let mut files = Vec::new();
+    let mut put = |name: String,
+                   write: &dyn Fn(&Path) -> anyhow::Result<()>|
+     -> anyhow::Result<()> {
+        let f = dir.join(name);
+        fsio::write_with(&f, write)?;
+        files.push(f);
+        Ok(())
+    };
+    put("force_displacement.csv".into(), &|f| {
+        csv::write_records(&outcome.records, f)
+    })?;
+    put("particles.csv".into(), &|f| csv::write_particles(outcome, f))?;
+    put("force_displacement.svg".into(), &|f| {
+        plots::force_displacement(outcome, f)
+    })?;
     let o = &outcome.scene.output;
     if outcome.damage.is_some() {
-        let f = dir.join("crack_map.svg");
-        plots::crack_map(outcome, o.crack_map_scale, &f)?;
-        files.push(f);
+        put("crack_map.svg".into(), &|f| {
+            plots::crack_map(outcome, o.crack_map_scale, f)
+        })?;
     }
     for (k, field) in outcome.fields.iter().enumerate() {
-        let f = dir.join(format!("random_field_{}.svg", field.property.name()));
-        plots::field_map(outcome, k, o.crack_map_scale, &f)?;
-        files.push(f);
+        put(
+            format!("random_field_{}.svg", field.property.name()),
+            &|f| plots::field_map(outcome, k, o.crack_map_scale, f),
+        )?;
     }
     if o.map {
-        let f = dir.join("particle_map.svg");
-        plots::particle_map(outcome, o.field, o.deformed_scale, &f)?;
-        files.push(f);
+        put("particle_map.svg".into(), &|f| {
+            plots::particle_map(outcome, o.field, o.deformed_scale, f)
+        })?;
     }
     if o.vtk {
-        let f = dir.join("particles.vtk");
-        vtk::write_particles(outcome, &f)?;
-        files.push(f);
+        put("particles.vtk".into(), &|f| vtk::write_particles(outcome, f))?;
     }
+    remove_stale(dir, &files)?;
+    write_summary(outcome, dir)?;
+    files.insert(0, summary);
     Ok(files)
+}
+
+/// Write the run's summary.json into `dir` (atomically).
+pub fn write_summary(outcome: &Outcome, dir: &Path) -> anyhow::Result<()> {
+    let path = dir.join("summary.json");
+    fsio::write_atomic(
+        &path,
+        (serde_json::to_string_pretty(&outcome.summary)? + "\n").as_bytes(),
+    )?;
+    Ok(())
+}
+
+/// Remove the run files in `dir` (and temporary files of interrupted writes) that are not
+/// in `keep`.
+fn remove_stale(dir: &Path, keep: &[PathBuf]) -> anyhow::Result<()> {
+    let entries = std::fs::read_dir(dir).map_err(|e| fsio::IoFailure::new("list", dir, e))?;
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let partial = name.starts_with('.')
+            && name.ends_with(".partial")
+            && is_run_file(&name[1..name.len() - ".partial".len()]);
+        if (is_run_file(&name) || partial) && !keep.contains(&entry.path()) {
+            let p = entry.path();
+            std::fs::remove_file(&p).map_err(|e| fsio::IoFailure::new("remove the stale", &p, e))?;
+        }
+    }
+    Ok(())
 }

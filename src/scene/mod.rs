@@ -407,6 +407,25 @@ pub enum Selection {
     All,
 }
 
+impl Selection {
+    /// The selection as the scene writes it, an inline TOML table
+    /// (`{ by = "box", max = [0.1, 0.2], min = [0.0, 0.0] }`), for messages.
+    pub fn scene_text(&self) -> String {
+        let value = serde_json::to_value(self).unwrap_or_default();
+        let Some(map) = value.as_object() else {
+            return value.to_string();
+        };
+        let mut items: Vec<String> = map
+            .iter()
+            .filter(|(_, v)| !v.is_null())
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect();
+        // `by` first, as a scene writes it
+        items.sort_by_key(|s| !s.starts_with("by ="));
+        format!("{{ {} }}", items.join(", ").replace(",", ", ").replace(",  ", ", "))
+    }
+}
+
 /// Displacement loading of one component of a group.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -543,6 +562,12 @@ pub struct SolverSpec {
     /// Relaxation: iteration limit of one increment.
     #[serde(default = "default_max_iterations")]
     pub max_iterations: usize,
+    /// Relaxation: the largest out-of-balance ratio (as `tolerance`) accepted at the end of
+    /// an increment that stopped at `max_iterations`. Left out, every increment must
+    /// converge to `tolerance`, and a run with one that did not has the status
+    /// "unconverged" (exit status 3).
+    #[serde(default)]
+    pub max_residual: Option<f64>,
 }
 
 /// How a run reaches the loaded state.
@@ -567,6 +592,7 @@ impl Default for SolverSpec {
             increments: default_increments(),
             tolerance: default_tolerance(),
             max_iterations: default_max_iterations(),
+            max_residual: None,
         }
     }
 }
@@ -669,8 +695,7 @@ impl Scene {
 
     /// Read a scene file; the scene's name defaults to the file stem.
     pub fn from_file(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SceneError::Io(format!("cannot read {}: {e}", path.display())))?;
+        let text = read_scene_text(path)?;
         let mut scene = Scene::from_toml_str(&text, overrides).map_err(|e| e.in_file(path))?;
         if scene.name.is_none() {
             scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned());
@@ -691,4 +716,34 @@ impl Scene {
             Some(DEFAULT_SEED)
         })
     }
+}
+
+/// Largest scene file sppm reads: a scene is a few kB of TOML, and this bounds a mistaken
+/// `/dev/zero` or data file given as the scene.
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
+/// The text of a scene file, read up to [`MAX_SCENE_BYTES`] (a larger file, or an endless
+/// one such as `/dev/zero`, is refused without reading it all).
+pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)
+        .map_err(|e| SceneError::Io(format!("cannot read {}: {e}", path.display())))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| SceneError::Io(format!("cannot read {}: {e}", path.display())))?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(SceneError::Io(format!(
+            "{}: a scene file is a TOML text of at most {} bytes; this one is larger (is it the scene?)",
+            path.display(),
+            MAX_SCENE_BYTES
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        SceneError::Io(format!(
+            "{}: a scene file is UTF-8 text; byte {} is not",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        ))
+    })
 }

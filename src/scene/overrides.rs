@@ -15,7 +15,23 @@ pub fn apply_overrides(root: &mut Table, overrides: &[String]) -> Result<(), Sce
             message: "expected key=value, e.g. material.E=3.0e10".into(),
         })?;
         let key = key.trim();
-        let value = parse_value(raw.trim());
+        let raw = raw.trim();
+        // an integer beyond TOML's range would otherwise be taken as a string
+        let digits = raw.strip_prefix(['-', '+']).unwrap_or(raw);
+        if !digits.is_empty()
+            && digits.bytes().all(|b| b.is_ascii_digit())
+            && raw.parse::<i64>().is_err()
+        {
+            return Err(SceneError::Override {
+                key: key.into(),
+                message: format!(
+                    "{raw} is beyond the integers a scene can hold ({} to {}, TOML's range)",
+                    i64::MIN,
+                    i64::MAX
+                ),
+            });
+        }
+        let value = parse_value(raw);
         set_path(root, key, value)?;
     }
     Ok(())

@@ -69,11 +69,16 @@ impl Scene {
     /// Check every value; the first problem found is returned.
     pub fn validate(&self) -> Result<(), SceneError> {
         if let Some(n) = &self.name {
-            if n.is_empty() || n.contains(['/', '\\']) {
+            if n.is_empty()
+                || n.contains(['/', '\\'])
+                || n.starts_with('.')
+                || n.chars().any(char::is_control)
+                || n.len() > 200
+            {
                 return Err(invalid(
                     "name",
                     format!("{n:?}"),
-                    "a non-empty name without path separators",
+                    "a plain folder name (it names output/<name>/): 1 to 200 characters, no path separators or control characters, not starting with '.'",
                 ));
             }
         }
@@ -367,7 +372,7 @@ impl Scene {
                     return Err(invalid(
                         "body.vertices",
                         format!("{vertices:?}"),
-                        "a simple polygon (its edges must not cross)",
+                        "a simple polygon: each vertex once, edges that neither cross, touch nor overlap (an outline traversed twice is refused)",
                     ));
                 }
             }
@@ -478,6 +483,15 @@ impl Scene {
                 s.max_iterations,
                 "an integer from 1 to 100000000 (iterations of one load increment)",
             ));
+        }
+        if let Some(r) = s.max_residual {
+            if !(r.is_finite() && r >= s.tolerance && r < 1.0) {
+                return Err(invalid(
+                    "solver.max_residual",
+                    r,
+                    &format!("must satisfy solver.tolerance = {} ≤ max_residual < 1 (the out-of-balance ratio accepted for an increment that stops at solver.max_iterations)", s.tolerance),
+                ));
+            }
         }
         if s.method == SolverMethod::Relaxation && s.force_lag == ForceLag::Previous {
             return Err(invalid(
