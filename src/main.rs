@@ -2,7 +2,7 @@
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use sppm::run::{estimated_memory, prepare, RunOptions};
+use sppm::run::{estimated_memory, prepare_with, RunOptions};
 use sppm::fsio::{FolderBusy, IoFailure};
 use sppm::{say, Scene};
 use std::path::PathBuf;
@@ -66,6 +66,10 @@ enum Command {
         study: sppm::study::cli::StudyCommand,
     },
 }
+
+/// `sppm check` reports its stages on stderr for bodies of at least this many particles
+/// (a 2.3e6-particle plate takes minutes to set up).
+const CHECK_PROGRESS_PARTICLES: f64 = 5e4;
 
 /// Exit statuses (README, docs/reliability.md).
 mod exit {
@@ -157,7 +161,16 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Check { scene, set } => {
             let sc = Scene::from_file(&scene, &set)?;
             let mem = estimated_memory(&sc);
-            let mut p = prepare(&sc)?;
+            // large bodies take minutes to set up: say what is going on (stderr)
+            let started = std::time::Instant::now();
+            let loud = sppm::run::estimated_particles(&sc) >= CHECK_PROGRESS_PARTICLES;
+            let stage = |what: &str| {
+                if loud {
+                    eprintln!("[{:7.1} s] {what}…", started.elapsed().as_secs_f64());
+                }
+            };
+            let mut p = prepare_with(&sc, &stage)?;
+            stage("timing a few steps of the kernel");
             // calibrate the run time with a few steps of the real kernel (with damage and
             // plasticity where the scene has them)
             let mut sim = sppm::run::build_simulation(&mut p);

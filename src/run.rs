@@ -91,6 +91,11 @@ pub struct Model {
 
 /// Discretise a scene and assemble its model: lattice, groups, supports, micro-moduli.
 pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
+    prepare_model_with(scene, &|_| {})
+}
+
+/// [`prepare_model`], telling `stage` what it starts (for `sppm check` of large bodies).
+pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, RunError> {
     let d = &scene.discretisation;
     let m = &scene.material;
     let need = estimated_memory(scene);
@@ -119,6 +124,10 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
         offset: Vector2::new(d.offset[0], d.offset[1]),
         thickness: m.thickness,
     };
+    stage(&format!(
+        "filling the body with about {:.3e} particles",
+        estimated_particles(scene)
+    ));
     let particles = lattice.fill(&shape);
     if particles.len() < 2 {
         return Err(RunError::Setup(format!(
@@ -190,6 +199,7 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
         .collect();
 
     // Micro-moduli, with the surface correction of particles that miss bonds.
+    stage("micro-moduli and the surface correction");
     let bulk = micro_modulus::hexagonal(m.youngs_modulus(), m.nu, d.spacing, m.thickness, m.plane);
     let dmat = micro_modulus::elasticity_matrix(m.youngs_modulus(), m.nu, m.plane);
     let mut a = vec![bulk.a; n];
@@ -228,6 +238,9 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
             }
             None => surface.kept_bulk += 1,
         }
+    }
+    if !scene.random_field.is_empty() {
+        stage("random fields");
     }
     // Random fields (MODEL.md §12), over the body's box: E scales the micro-moduli here, the
     // concrete values go to the damage kernel (`build_simulation`).
@@ -284,7 +297,13 @@ fn modal_failure(model: &Model, e: modal::ModalError) -> RunError {
 
 /// Discretise and assemble a scene, compute T1 and the time step.
 pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
-    let mut model = prepare_model(scene)?;
+    prepare_with(scene, &|_| {})
+}
+
+/// [`prepare`], telling `stage` what it starts (for `sppm check` of large bodies).
+pub fn prepare_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Prepared, RunError> {
+    let mut model = prepare_model_with(scene, stage)?;
+    stage("fundamental period T1 (Lanczos)");
     let d = &scene.discretisation;
     let m = &scene.material;
     let n = model.particles.len();
@@ -297,6 +316,7 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
         mech.c_in[i] = 2.0 * mech.mass[i] * scene.damping.internal * omega_i;
         mech.c_ex[i] = 2.0 * mech.mass[i] * scene.damping.external * omega_struct;
     }
+    stage("stable time step (largest frequency, Lanczos)");
     let stable = stable_step(&model.mech, &model.particles.x0);
     let dt = match scene.solver.dt {
         Some(dt) if dt > stable.dt_stable => {
@@ -680,7 +700,7 @@ fn run_explicit(
         }
         if want || n % 64 == 0 {
             let u = rec.map(|r| r.internal_j);
-            if let Err(e) = sim.check_stability(u) {
+            if let Err(e) = sim.check_stability(u, true) {
                 failure = Some(e);
                 break;
             }

@@ -99,7 +99,14 @@ fn relaxation_does_not_depend_on_the_thread_count() {
 /// asserts (tests/concrete.rs).
 #[test]
 fn relaxed_tension_block_reaches_ft() {
-    let scene = tension_block(0.1, 0.01, &["solver.method=relaxation"]);
+    // After the peak 50 of the 200 increments stop at max_iterations with at most 0.58% of
+    // the reactions out of balance (still 0.67% with 10× the iterations: the softening
+    // branch is where dynamic relaxation stalls, issue 16); the scene accepts 1%.
+    let scene = tension_block(
+        0.1,
+        0.01,
+        &["solver.method=relaxation", "solver.max_residual=0.01"],
+    );
     let law = scene.concrete_law().unwrap();
     let area = 0.15 * 0.15;
     let out = run(&scene, 2);
@@ -115,6 +122,7 @@ fn relaxed_tension_block_reaches_ft() {
         sm.unconverged_increments.unwrap()
     );
     assert_eq!(sm.status, "completed");
+    assert!(sm.max_final_residual.unwrap() <= 0.01);
     assert!(
         (sm.peak_force_n / fta - 1.0).abs() <= 0.05,
         "peak {} N against f't·A = {fta} N",

@@ -150,7 +150,7 @@ fn forced(p: &mut Prepared, dt: f64, max_steps: usize) -> (Simulation<2, 6>, Opt
     };
     for _ in 0..max_steps {
         let rec = sim.advance(Some(&probe)).unwrap();
-        if let Err(e) = sim.check_stability(Some(rec.internal_j)) {
+        if let Err(e) = sim.check_stability(Some(rec.internal_j), true) {
             return (sim, Some(e));
         }
     }
@@ -351,7 +351,7 @@ fn contrast_of_1000_in_e_between_neighbours() {
             let mut failure = None;
             for _ in 0..4000 {
                 let r = sim.advance(Some(&probe)).unwrap();
-                if let Err(e) = sim.check_stability(Some(r.internal_j)) {
+                if let Err(e) = sim.check_stability(Some(r.internal_j), true) {
                     failure = Some(e);
                     break;
                 }

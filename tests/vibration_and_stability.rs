@@ -169,7 +169,7 @@ fn energy_history(lagged: bool, periods: f64) -> (Vec<f64>, Option<String>, f64)
         let rec = sim.advance(if n % 50 == 0 { Some(&probe) } else { None });
         if let Some(r) = rec {
             energy.push(r.kinetic_j + r.internal_j);
-            if let Err(e) = sim.check_stability(Some(r.internal_j)) {
+            if let Err(e) = sim.check_stability(Some(r.internal_j), true) {
                 return (energy, Some(e.to_string()), e0);
             }
         }
@@ -213,11 +213,11 @@ fn instability_threshold(internal_damping: f64, steps: usize) -> (f64, f64) {
         let mut sim = released(&p, false, f * p.stable.dt_stable);
         for n in 0..steps {
             sim.advance(None);
-            if n % 50 == 0 && sim.check_stability(None).is_err() {
+            if n % 50 == 0 && sim.check_stability(None, true).is_err() {
                 return false;
             }
         }
-        sim.check_stability(None).is_ok()
+        sim.check_stability(None, true).is_ok()
     };
     let (mut lo, mut hi) = (0.5, 3.0);
     assert!(stays_bounded(lo));

@@ -36,14 +36,20 @@ pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Columns of particles.csv (README, "Outputs").
+pub const PARTICLE_COLUMNS: [&str; 7] = ["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];
+
+/// Columns particles.csv adds for scenes with damage: w_t, w_c and yielded (0 or 1).
+pub const DAMAGE_COLUMNS: [&str; 3] = ["tensile_damage", "compressive_damage", "yielded"];
+
 /// particles.csv: one row per particle at the end of the run: reference position, displacement,
 /// stress (3.18) and, with damage, w_t, w_c and whether it yielded.
 pub fn write_particles(o: &crate::run::Outcome, path: &Path) -> anyhow::Result<()> {
     let mut w = ::csv::Writer::from_path(path)
         .with_context(|| format!("cannot write {}", path.display()))?;
-    let mut head = vec!["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];
+    let mut head = PARTICLE_COLUMNS.to_vec();
     if o.damage.is_some() {
-        head.extend(["tensile_damage", "compressive_damage", "yielded"]);
+        head.extend(DAMAGE_COLUMNS);
     }
     w.write_record(&head)?;
     for i in 0..o.x0.len() {

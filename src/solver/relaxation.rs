@@ -360,7 +360,7 @@ pub fn relax<const D: usize, const K: usize>(
                 break;
             }
             if it % 64 == 0 {
-                if let Err(e) = sim.check_stability(None) {
+                if let Err(e) = sim.check_stability(None, false) {
                     out.failure = Some(e);
                     out.iterations += it;
                     break 'increments;
@@ -368,7 +368,7 @@ pub fn relax<const D: usize, const K: usize>(
             }
         }
         out.iterations += it;
-        if let Err(e) = sim.check_stability(None) {
+        if let Err(e) = sim.check_stability(None, false) {
             out.failure = Some(e);
             break;
         }

@@ -1,0 +1,249 @@
+//! Fuzzing the command line (issue 11): random counts for `bench`, `study objectivity` and
+//! `study montecarlo`, and random `--set` values for `run` and `check` of a tiny scene. Every
+//! command must end without a panic, and none may exit 0 with a NaN result. Each command is
+//! given a few seconds (a huge but acceptable count simply runs; it is stopped there), so
+//! the fuzzer's time is bounded: at most CASES × LIMIT.
+
+use proptest::prelude::*;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const CASES: u32 = 48;
+const LIMIT: Duration = Duration::from_secs(4);
+
+const PLATE: &str = r#"
+name = "fuzz_plate"
+[body]
+shape = "rectangle"
+width = 0.1
+height = 0.2
+[discretisation]
+spacing = 0.02
+[material]
+E = 30.0e9
+nu = 0.2
+rho = 2400.0
+thickness = 0.05
+[[groups]]
+name = "bottom"
+select = { by = "edge", edge = "bottom", rows = 1 }
+fix = ["x", "y"]
+[[groups]]
+name = "top"
+select = { by = "edge", edge = "top", rows = 1 }
+load = { component = "y", displacement = 1.0e-5 }
+[loading]
+end_periods = 2.0
+"#;
+
+const DOGBONE: &str = r#"
+name = "fuzz_dogbone"
+[body]
+shape = "dogbone"
+size = 0.05
+[discretisation]
+spacing = 0.01
+[material]
+nu = 0.2
+rho = 2183.0
+thickness = 0.1
+[concrete]
+preset = "splm_dogbone"
+[[random_field]]
+property = "ft"
+correlation = "exponential"
+length = 0.02
+marginal = "normal"
+cov = 0.1
+[[groups]]
+name = "bottom"
+select = { by = "edge", edge = "bottom", rows = 1 }
+fix = ["x", "y"]
+[[groups]]
+name = "top"
+select = { by = "edge", edge = "top", rows = 1 }
+load = { component = "y", displacement = 0.5e-3 }
+[solver]
+method = "relaxation"
+increments = 20
+max_residual = 0.5
+[loading]
+stop_after_peak = 0.8
+"#;
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sppm-fuzz-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn scene(name: &str, text: &str) -> String {
+    let p = dir().join(name);
+    if !p.exists() {
+        std::fs::write(&p, text).unwrap();
+    }
+    p.to_string_lossy().into_owned()
+}
+
+/// Run sppm for at most LIMIT: (exit code, None if stopped), stdout, stderr.
+fn run(args: &[String]) -> (Option<i32>, String, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sppm"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // read both pipes on threads so that a chatty child never blocks on a full pipe
+    let mut so = child.stdout.take().unwrap();
+    let mut se = child.stderr.take().unwrap();
+    let t_out = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = so.read_to_string(&mut s);
+        s
+    });
+    let t_err = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = se.read_to_string(&mut s);
+        s
+    });
+    let start = Instant::now();
+    let code = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st.code();
+        }
+        if start.elapsed() > LIMIT {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    (code, t_out.join().unwrap(), t_err.join().unwrap())
+}
+
+/// No panic; exit 0 only with finite results.
+fn judge(args: &[String], out_dir: Option<&Path>) -> Result<(), TestCaseError> {
+    let (code, out, err) = run(args);
+    prop_assert!(
+        !err.contains("panicked") && code != Some(101),
+        "{args:?} panicked: {err}"
+    );
+    if code == Some(0) {
+        prop_assert!(!out.contains("NaN"), "{args:?} exit 0 with NaN: {out}");
+        if let Some(d) = out_dir {
+            if let Ok(text) = std::fs::read_to_string(d.join("summary.json")) {
+                let s: serde_json::Value = serde_json::from_str(&text).unwrap();
+                for key in ["peak_force_N", "dissipated_energy_J", "external_work_J"] {
+                    prop_assert!(
+                        s[key].as_f64().is_some_and(f64::is_finite),
+                        "{args:?} exit 0 with {key} = {}",
+                        s[key]
+                    );
+                }
+                prop_assert_eq!(&s["status"], "completed");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Counts as a user might type them: small, large, at the integer limits, or not numbers.
+fn count() -> impl Strategy<Value = String> {
+    prop_oneof![
+        (0u64..4).prop_map(|v| v.to_string()),
+        (0u64..1_000_000_000_000).prop_map(|v| v.to_string()),
+        Just(u64::MAX.to_string()),
+        Just(usize::MAX.to_string()),
+        Just("18446744073709551616".to_string()),
+        Just("-1".to_string()),
+        Just("1e9".to_string()),
+        Just("".to_string()),
+    ]
+}
+
+/// Scene values: numbers of every magnitude and sign, non-finite ones, and wrong types.
+fn value() -> impl Strategy<Value = String> {
+    prop_oneof![
+        any::<f64>().prop_map(|v| format!("{v:e}")),
+        (-3i32..4).prop_map(|e| format!("{}", 10f64.powi(e))),
+        (-1e6f64..1e6).prop_map(|v| v.to_string()),
+        any::<i64>().prop_map(|v| v.to_string()),
+        Just("nan".to_string()),
+        Just("inf".to_string()),
+        Just("-inf".to_string()),
+        Just(u64::MAX.to_string()),
+        Just("\"text\"".to_string()),
+        Just("[1.0, 2.0]".to_string()),
+        Just("true".to_string()),
+        Just("".to_string()),
+    ]
+}
+
+const KEYS: [&str; 18] = [
+    "discretisation.spacing",
+    "discretisation.rotation_deg",
+    "discretisation.offset",
+    "material.E",
+    "material.nu",
+    "material.rho",
+    "material.thickness",
+    "loading.end_periods",
+    "loading.ramp_fraction",
+    "solver.safety",
+    "solver.dt",
+    "solver.threads",
+    "damping.internal",
+    "damping.external",
+    "output.records",
+    "groups.top.load.displacement",
+    "seed",
+    "name",
+];
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: CASES, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn no_command_panics_or_reports_nan(
+        which in 0usize..5,
+        a in count(),
+        b in count(),
+        c in count(),
+        key in 0usize..KEYS.len(),
+        v in value(),
+        k2 in 0usize..KEYS.len(),
+        v2 in value(),
+        case in 0u64..u64::MAX,
+    ) {
+        let out = dir().join(format!("out-{case}"));
+        let o = out.to_string_lossy().into_owned();
+        let s = |x: &str| x.to_string();
+        let args: Vec<String> = match which {
+            0 => vec![s("bench"), s("--particles"), a, s("--steps"), b, s("--threads"), c.chars().take(2).collect()],
+            1 => vec![s("study"), s("objectivity"), scene("plate.toml", PLATE), s("--angles"), s("0"),
+                      s("--offsets"), a, s("--jobs"), b.chars().take(1).collect(), s("--quiet"), s("--out"), o.clone()],
+            2 => vec![s("study"), s("montecarlo"), scene("dogbone.toml", DOGBONE), s("--realisations"), a,
+                      s("--seed"), b, s("--shard"), format!("{}/{}", c, a_or(&c)), s("--jobs"), s("1"),
+                      s("--quiet"), s("--out"), o.clone()],
+            3 => vec![s("run"), scene("plate.toml", PLATE), s("--quiet"), s("--out"), o.clone(),
+                      s("--set"), format!("{}={v}", KEYS[key]), s("--set"), format!("{}={v2}", KEYS[k2])],
+            _ => vec![s("check"), scene("plate.toml", PLATE),
+                      s("--set"), format!("{}={v}", KEYS[key]), s("--set"), format!("{}={v2}", KEYS[k2])],
+        };
+        let r = judge(&args, Some(&out));
+        let _ = std::fs::remove_dir_all(&out);
+        r?;
+    }
+}
+
+/// A shard count to pair with `k`: sometimes the same, sometimes another count.
+fn a_or(k: &str) -> String {
+    match k.len() % 3 {
+        0 => k.to_string(),
+        1 => "2".into(),
+        _ => "1000000".into(),
+    }
+}
