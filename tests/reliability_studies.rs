@@ -363,6 +363,26 @@ fn a_merge_names_missing_shards_and_runs_and_needs_partial() {
     );
     assert!(err.contains("D = 0.05 m: 1 of 2 realisations"), "{err}");
     assert!(!err.contains("not given"), "both shards were given: {err}");
+
+    // the merged folder is locked while a merge writes it: a merge into a folder another
+    // process holds is refused, naming the holder (here this test process)
+    let lock = sppm::fsio::FolderLock::acquire(&merged).unwrap();
+    let o = merge(&[&s1, &s2], &["--partial"]);
+    let err = text(&o).1;
+    assert!(
+        matches!(o.status.code(), Some(5) | Some(2)),
+        "{:?} {err}",
+        o.status
+    );
+    assert!(
+        err.contains(&format!(
+            "{} is in use by another sppm process (process {}:",
+            merged.display(),
+            std::process::id()
+        )),
+        "{err}"
+    );
+    drop(lock);
     let _ = std::fs::remove_dir_all(&base);
 }
 
