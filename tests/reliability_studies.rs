@@ -414,7 +414,11 @@ fn rows_without_an_inputs_record_are_not_adopted() {
     let err = text(&o).1;
     assert_eq!(o.status.code(), Some(2), "{err}");
     for want in [
-        format!("{} holds 2 study rows in {}", out.display(), csv.display()),
+        format!(
+            "{} holds study rows (2 in {})",
+            out.display(),
+            csv.display()
+        ),
         "but no study_inputs.json".to_string(),
         "does not adopt them".to_string(),
         "use another --out folder".to_string(),
@@ -451,7 +455,7 @@ fn rows_without_an_inputs_record_are_not_adopted() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
         err.contains(&format!(
-            "holds 1 study rows in {}",
+            "holds study rows (1 in {})",
             mc.join("realisations.csv").display()
         )),
         "{err}"

@@ -619,10 +619,10 @@ pub fn study_rows_in(dir: &Path) -> anyhow::Result<Option<(PathBuf, usize)>> {
 /// Why a folder with study rows but no inputs record is refused.
 pub fn no_inputs_record(dir: &Path, csv: &Path, rows: usize) -> String {
     format!(
-        "{} holds {rows} study rows in {} but no {INPUTS_FILE}, the record of the inputs (scene, overrides, seed) they were made with, so sppm cannot tell whether they belong to this study and does not adopt them: use another --out folder, or remove {} (or the whole folder) to start afresh",
+        "{} holds study rows ({rows} in {}) but no {INPUTS_FILE}, the record of the inputs (scene, overrides, seed) they were made with, so sppm cannot tell whether they belong to this study and does not adopt them: use another --out folder, or remove the folder's study CSVs (or the whole folder {}) to start afresh",
         dir.display(),
         csv.display(),
-        csv.display()
+        dir.display()
     )
 }
 
