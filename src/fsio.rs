@@ -108,10 +108,16 @@ fn find_io(e: &anyhow::Error) -> Option<std::io::ErrorKind> {
         }
     }
     let text = format!("{e:#}");
-    ["No space left", "File too large", "Permission denied", "Read-only file system", "Disk quota"]
-        .iter()
-        .any(|s| text.contains(s))
-        .then_some(std::io::ErrorKind::Other)
+    [
+        "No space left",
+        "File too large",
+        "Permission denied",
+        "Read-only file system",
+        "Disk quota",
+    ]
+    .iter()
+    .any(|s| text.contains(s))
+    .then_some(std::io::ErrorKind::Other)
 }
 
 /// Write `bytes` to `path` atomically (temporary file, flush, rename).

@@ -83,6 +83,10 @@ pub enum StudyCommand {
         /// Folder of the merged study (default: output/<scene name>-montecarlo).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Write the report even if the folders lack runs their commands asked for (a shard
+        /// not given or not finished); size_effect.json then records that it is partial.
+        #[arg(long)]
+        partial: bool,
     },
 }
 
@@ -130,7 +134,9 @@ pub fn parse_list(option: &str, text: &str) -> anyhow::Result<Vec<f64>> {
         .collect()
 }
 
-/// Run a study command; exit status 0, or 3 when a run went unstable (its row says so).
+/// Run a study command; exit status 0, or 3 when a run did not complete (went unstable or
+/// could not be set up: its row says so; a Monte Carlo size without a completed realisation
+/// is named). Errors (bad input, a busy folder, an incomplete merge) are the caller's.
 pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         StudyCommand::Objectivity {
@@ -218,11 +224,13 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 jobs: jobs.unwrap_or_else(default_jobs),
                 progress: !quiet,
             })?;
+            let mut empty = vec![];
             match &report.size_effect {
                 Some(effect) => {
                     for l in effect.lines() {
                         println!("{l}");
                     }
+                    empty = effect.sizes_without_realisations();
                 }
                 None => println!(
                     "shard done: {} runs in {} (combine the shards with `sppm study merge`)",
@@ -233,16 +241,42 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
             if !quiet {
                 println!("wrote {}", report.dir.display());
             }
-            Ok(ExitCode::SUCCESS)
+            no_data(&empty, "realisations.csv");
+            Ok(status(report.completed, report.runs))
         }
-        StudyCommand::Merge { dirs, out } => {
-            let effect = merge(&dirs, out)?;
-            for l in effect.lines() {
+        StudyCommand::Merge { dirs, out, partial } => {
+            let merged = merge(&dirs, out, partial)?;
+            for n in &merged.notes {
+                eprintln!("note: {n}");
+            }
+            if !merged.missing.is_empty() {
+                eprintln!(
+                    "warning: partial merge (--partial): the report covers only the runs there are, and size_effect.json records it; missing: {}",
+                    merged.missing.join("; ")
+                );
+            }
+            for l in merged.effect.lines() {
                 println!("{l}");
             }
-            println!("wrote {}", effect.dir.display());
-            Ok(ExitCode::SUCCESS)
+            println!("wrote {}", merged.effect.dir.display());
+            no_data(
+                &merged.effect.sizes_without_realisations(),
+                "realisations.csv",
+            );
+            Ok(status(merged.completed, merged.runs))
         }
+    }
+}
+
+/// Say which sizes have no completed realisation (their statistics are NaN).
+fn no_data(sizes: &[f64], csv: &str) {
+    if !sizes.is_empty() {
+        let list: Vec<String> = sizes.iter().map(|d| format!("{d} m")).collect();
+        eprintln!(
+            "error: no realisation completed at D = {}: no statistics for {} (NaN in size_effect.csv, null in size_effect.json; see the status and message of the runs in {csv})",
+            list.join(", "),
+            if sizes.len() == 1 { "it" } else { "them" }
+        );
     }
 }
 

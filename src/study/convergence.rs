@@ -141,14 +141,14 @@ pub fn convergence(args: &ConvergenceArgs) -> anyhow::Result<ConvergenceReport> 
     // coarse to fine; the coarse runs are fast, the finest is the one worth waiting for
     let mut spacings = args.spacings_m.clone();
     spacings.sort_by(|a, b| b.total_cmp(a));
-    let variants: Vec<Variant> = spacings
-        .iter()
-        .map(|&h| Variant {
+    let make = |k: usize| {
+        let h = spacings[k];
+        Variant {
             label: label(h),
             overrides: vec![format!("discretisation.spacing={h:?}")],
             tags: vec![],
-        })
-        .collect();
+        }
+    };
     let metrics = |_: &crate::run::Outcome| Vec::new();
     let study = Study {
         scene: args.scene.clone(),
@@ -167,7 +167,22 @@ pub fn convergence(args: &ConvergenceArgs) -> anyhow::Result<ConvergenceReport> 
         progress: args.progress,
         outputs: super::runner::RunOutputs::All,
     };
-    let results: Vec<RunResult> = study.run(&variants)?;
+    crate::limits::check_count_of(
+        &format!("--spacings: {} runs", spacings.len()),
+        spacings.len() as f64,
+        study.bytes_per_run(&base),
+        "runs",
+        "fewer --spacings",
+    )?;
+    let runs = super::runner::Runs {
+        count: spacings.len(),
+        variant: &make,
+        // every spacing is a kind of its own (its own lattice)
+        probes: (0..spacings.len()).collect(),
+    };
+    study.check(&runs)?;
+    let lock = crate::fsio::FolderLock::acquire(&dir)?;
+    let results: Vec<RunResult> = study.run(&lock, &runs)?;
     let done: Vec<&RunRow> = results
         .iter()
         .map(|r| &r.row)
@@ -207,25 +222,26 @@ pub fn convergence(args: &ConvergenceArgs) -> anyhow::Result<ConvergenceReport> 
             },
         }
     };
-    super::plots::convergence(
-        &format!("{}: convergence with the lattice spacing", base.name()),
-        &[
-            panel("peak force (kN)", &report.peak_force, 1e-3, "kN", &|r| {
-                r.peak_force_n
-            }),
-            panel(
-                "dissipated energy (J)",
-                &report.dissipated_energy,
-                1.0,
-                "J",
-                &|r| r.dissipated_energy_j,
-            ),
-        ],
-        &dir.join("convergence.svg"),
+    let title = format!("{}: convergence with the lattice spacing", base.name());
+    let panels = [
+        panel("peak force (kN)", &report.peak_force, 1e-3, "kN", &|r| {
+            r.peak_force_n
+        }),
+        panel(
+            "dissipated energy (J)",
+            &report.dissipated_energy,
+            1.0,
+            "J",
+            &|r| r.dissipated_energy_j,
+        ),
+    ];
+    crate::fsio::write_with(&dir.join("convergence.svg"), |tmp: &std::path::Path| {
+        super::plots::convergence(&title, &panels, tmp)
+    })?;
+    crate::fsio::write_atomic(
+        &dir.join("convergence.json"),
+        (serde_json::to_string_pretty(&report)? + "\n").as_bytes(),
     )?;
-    std::fs::write(
-        dir.join("convergence.json"),
-        serde_json::to_string_pretty(&report)? + "\n",
-    )?;
+    drop(lock);
     Ok(report)
 }

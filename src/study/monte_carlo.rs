@@ -32,7 +32,7 @@
 //!   `size_effect.svg` ([`super::size_effect_report`]); `sppm study merge` combines shard
 //!   folders into the same files.
 
-use super::runner::{RunOutputs, RunRow, Study, Variant};
+use super::runner::{RunOutputs, RunRow, Runs, Study, Variant};
 use super::size_effect_report::{report, tag_f64, SizeEffect};
 use crate::material::random_field::splitmix64;
 use crate::run::Outcome;
@@ -134,23 +134,148 @@ pub struct Item {
     pub realisation: Option<usize>,
 }
 
-/// The runs of `shard` (all runs without one) among `sizes` sizes × (1 deterministic +
-/// `realisations`), listed slot-major (module docs).
-pub fn shard_items(sizes: usize, realisations: usize, shard: Option<Shard>) -> Vec<Item> {
-    let mut out = Vec::new();
-    for slot in 0..=realisations {
-        for size in 0..sizes {
-            let index = slot * sizes + size;
-            if shard.is_none_or(|s| index % s.n == s.k - 1) {
-                out.push(Item {
-                    size,
-                    realisation: slot.checked_sub(1),
-                });
-            }
+/// The runs of one shard (or of the whole study), largest size first and within a size in
+/// the order of the realisations, without listing them: a shard of R realisations and a
+/// million shards is a few numbers per size, not a list of runs.
+///
+/// The runs of size s in shard k/n are the slots x with x·S + s ≡ k − 1 (mod n) (S sizes,
+/// module docs): none, or every slot x0 + t·p with p = n/gcd(S, n).
+#[derive(Clone, Debug)]
+pub struct ShardRuns {
+    /// Per size, largest first.
+    per_size: Vec<SizeRuns>,
+    /// Slots between two runs of one size in the shard.
+    step: u128,
+    realisations: u128,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct SizeRuns {
+    size: usize,
+    /// The deterministic run (slot 0) is in the shard.
+    deterministic: bool,
+    /// First realisation slot (≥ 1) in the shard, and how many realisations of this size.
+    first_slot: u128,
+    count: u128,
+    /// Realisations of the larger sizes before this one.
+    before: u128,
+}
+
+fn gcd(a: u128, b: u128) -> u128 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// The inverse of `a` modulo `m` (gcd(a, m) = 1, m ≥ 2).
+fn mod_inverse(a: u128, m: u128) -> u128 {
+    // extended Euclid on (a, m) < 2^65: fits i128
+    let (mut r0, mut r1) = (a as i128, m as i128);
+    let (mut s0, mut s1) = (1i128, 0i128);
+    while r1 != 0 {
+        let q = r0 / r1;
+        (r0, r1) = (r1, r0 - q * r1);
+        (s0, s1) = (s1, s0 - q * s1);
+    }
+    s0.rem_euclid(m as i128) as u128
+}
+
+impl ShardRuns {
+    /// The runs of `shard` (all runs without one) of `sizes` (D in m) × (1 deterministic +
+    /// `realisations`).
+    pub fn new(sizes: &[f64], realisations: usize, shard: Option<Shard>) -> ShardRuns {
+        let ns = sizes.len() as u128;
+        let (k, n) = shard.map_or((1, 1), |s| (s.k as u128, s.n as u128));
+        let a = ns % n;
+        let g = gcd(a, n);
+        let step = n / g;
+        let r = realisations as u128;
+        let mut order: Vec<usize> = (0..sizes.len()).collect();
+        order.sort_by(|&x, &y| sizes[y].total_cmp(&sizes[x]));
+        let mut before = 0;
+        let mut per_size = Vec::with_capacity(order.len());
+        for size in order {
+            let c = (k - 1 + n - size as u128 % n) % n;
+            let (deterministic, first_slot, count) = if !c.is_multiple_of(g) {
+                (false, 0, 0)
+            } else {
+                let x0 = if step == 1 {
+                    0
+                } else {
+                    (c / g % step) * mod_inverse(a / g % step, step) % step
+                };
+                let first = if x0 == 0 { step } else { x0 };
+                let count = if first > r { 0 } else { (r - first) / step + 1 };
+                (x0 == 0, first, count)
+            };
+            per_size.push(SizeRuns {
+                size,
+                deterministic,
+                first_slot,
+                count,
+                before,
+            });
+            before += count;
+        }
+        ShardRuns {
+            per_size,
+            step,
+            realisations: before,
         }
     }
-    out
+
+    /// Realisation runs in the shard.
+    pub fn realisations(&self) -> u128 {
+        self.realisations
+    }
+
+    /// Size indices whose deterministic run is in the shard, largest size first.
+    pub fn deterministic(&self) -> Vec<usize> {
+        self.per_size
+            .iter()
+            .filter(|s| s.deterministic)
+            .map(|s| s.size)
+            .collect()
+    }
+
+    /// Realisation runs of size index `size` in the shard.
+    pub fn realisations_of(&self, size: usize) -> u128 {
+        self.per_size
+            .iter()
+            .find(|s| s.size == size)
+            .map_or(0, |s| s.count)
+    }
+
+    /// Realisation run `j` (0 ≤ j < [`Self::realisations`]) of the shard.
+    pub fn realisation(&self, j: usize) -> Item {
+        let j = j as u128;
+        let s = self
+            .per_size
+            .iter()
+            .find(|s| j >= s.before && j < s.before + s.count)
+            .expect("realisation run index in the shard");
+        let slot = s.first_slot + (j - s.before) * self.step;
+        Item {
+            size: s.size,
+            realisation: Some((slot - 1) as usize),
+        }
+    }
+
+    /// The index of the first realisation run of each size that has one (probes).
+    pub fn first_of_each_size(&self) -> Vec<usize> {
+        self.per_size
+            .iter()
+            .filter(|s| s.count > 0)
+            .map(|s| s.before as usize)
+            .collect()
+    }
 }
+
+/// What a Monte Carlo command in a folder was last asked for (realisations, sizes, shard),
+/// written when it starts: `sppm study merge` checks the folder's rows against it.
+pub const REQUEST_FILE: &str = "study_request.json";
 
 /// The study's inputs.
 #[derive(Clone, Debug)]
@@ -285,6 +410,8 @@ fn studies<'a>(
 pub struct MonteCarloReport {
     pub dir: PathBuf,
     pub runs: usize,
+    /// Runs (realisations and deterministic) that completed.
+    pub completed: usize,
     pub size_effect: Option<SizeEffect>,
 }
 
@@ -355,46 +482,94 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
         args.progress,
         outputs,
     );
-    let mut items = shard_items(sizes.len(), args.realisations, args.shard);
+    let plan = ShardRuns::new(&sizes, args.realisations, args.shard);
+    let det_sizes = plan.deterministic();
+    let total = plan.realisations() + det_sizes.len() as u128;
+    crate::limits::check_count_of(
+        &format!(
+            "--realisations {} with {} size{}{}: {total} runs{}",
+            args.realisations,
+            sizes.len(),
+            if sizes.len() == 1 { "" } else { "s" },
+            args.shard.map(|s| format!(" and --shard {s}")).unwrap_or_default(),
+            if args.shard.is_some() { " in this shard" } else { "" }
+        ),
+        total as f64,
+        mc.bytes_per_run(&base),
+        "runs",
+        "fewer --realisations, or split the study with --shard k/n and combine the shards with `sppm study merge`",
+    )?;
+    // the size variants' overrides, once per size
+    let size_o: Vec<Vec<String>> = sizes.iter().map(|&d| size_overrides(&base, d)).collect();
     // largest first: the long runs start early and the last ones to finish are short
-    items.sort_by(|a, b| {
-        sizes[b.size]
-            .total_cmp(&sizes[a.size])
-            .then(a.realisation.cmp(&b.realisation))
-    });
-    let mut det_variants = Vec::new();
-    let mut mc_variants = Vec::new();
-    for it in &items {
-        let d = sizes[it.size];
-        let mut overrides = size_overrides(&base, d);
-        match it.realisation {
-            None => {
-                // the mean properties everywhere: no random field, no seed
-                overrides.push("random_field=[]".into());
-                det_variants.push(Variant {
-                    label: format!("{}-det", size_label(d)),
-                    overrides,
-                    tags: vec![d.to_string(), String::new()],
-                });
-            }
-            Some(r) => {
-                let seed = realisation_seed(args.seed, d, r);
-                overrides.push(format!("seed={seed}"));
-                mc_variants.push(Variant {
-                    label: format!("{}-r{r}", size_label(d)),
-                    overrides,
-                    tags: vec![d.to_string(), r.to_string(), seed.to_string()],
-                });
-            }
+    let det_make = |j: usize| {
+        let s = det_sizes[j];
+        let d = sizes[s];
+        let mut overrides = size_o[s].clone();
+        // the mean properties everywhere: no random field, no seed
+        overrides.push("random_field=[]".into());
+        Variant {
+            label: format!("{}-det", size_label(d)),
+            overrides,
+            tags: vec![d.to_string(), String::new()],
         }
+    };
+    let mc_make = |j: usize| {
+        let it = plan.realisation(j);
+        let d = sizes[it.size];
+        let r = it.realisation.expect("a realisation");
+        let seed = realisation_seed(args.seed, d, r);
+        let mut overrides = size_o[it.size].clone();
+        overrides.push(format!("seed={seed}"));
+        Variant {
+            label: format!("{}-r{r}", size_label(d)),
+            overrides,
+            tags: vec![d.to_string(), r.to_string(), seed.to_string()],
+        }
+    };
+    let det_runs = Runs {
+        count: det_sizes.len(),
+        variant: &det_make,
+        probes: (0..det_sizes.len()).collect(),
+    };
+    let mc_runs = Runs {
+        count: plan.realisations() as usize,
+        variant: &mc_make,
+        probes: plan.first_of_each_size(),
+    };
+    det.check(&det_runs)?;
+    mc.check(&mc_runs)?;
+    if total == 0 {
+        eprintln!(
+            "warning: --shard {} of {} runs holds none of them",
+            args.shard.map(|s| s.to_string()).unwrap_or_default(),
+            (args.realisations as u128 + 1) * sizes.len() as u128
+        );
     }
-    let det_results = det.run(&det_variants)?;
-    let mc_results = mc.run(&mc_variants)?;
+    let lock = crate::fsio::FolderLock::acquire(&dir)?;
+    det.check_inputs()?;
+    let request = json!({
+        "realisations": args.realisations,
+        "sizes_m": sizes,
+        "shard": args.shard.map(|s| s.to_string()),
+    });
+    crate::fsio::write_atomic(
+        &dir.join(REQUEST_FILE),
+        (serde_json::to_string_pretty(&request)? + "\n").as_bytes(),
+    )?;
+    let det_results = det.run(&lock, &det_runs)?;
+    let mc_results = mc.run(&lock, &mc_runs)?;
     let runs = det_results.len() + mc_results.len();
+    let completed = det_results
+        .iter()
+        .chain(&mc_results)
+        .filter(|r| r.row.completed())
+        .count();
     if args.shard.is_some() {
         return Ok(MonteCarloReport {
             dir,
             runs,
+            completed,
             size_effect: None,
         });
     }
@@ -415,11 +590,58 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
         args.realisations
     );
     let effect = report(&dir, &rows(mc_results), &rows(det_results), meta, &title)?;
+    drop(lock);
     Ok(MonteCarloReport {
         dir,
         runs,
+        completed,
         size_effect: Some(effect),
     })
+}
+
+/// What `sppm study merge` did: the size effect, what the folders lack against what their
+/// commands asked for (empty: the whole study), and the counts of runs.
+pub struct MergeReport {
+    pub effect: SizeEffect,
+    pub missing: Vec<String>,
+    /// Notes on folders whose request is not recorded (made by an older sppm).
+    pub notes: Vec<String>,
+    pub runs: usize,
+    pub completed: usize,
+}
+
+/// Refuse to merge into `out` when it holds another study, or study rows without an inputs
+/// record.
+fn check_merge_out(out: &Path, inputs: &serde_json::Value) -> anyhow::Result<()> {
+    let path = out.join(super::runner::INPUTS_FILE);
+    match std::fs::read_to_string(&path) {
+        Ok(text) => {
+            let old: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+            let mut old_unsharded = old.clone();
+            if let Some(o) = old_unsharded.as_object_mut() {
+                o.insert("shard".into(), serde_json::Value::Null);
+            }
+            if old_unsharded != *inputs {
+                bail!(
+                    "{} holds another study ({old}); the shards are from {inputs}: use another --out folder or remove it",
+                    out.display()
+                );
+            }
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            if let Some((csv, rows)) = super::runner::study_rows_in(out)? {
+                bail!("{}", super::runner::no_inputs_record(out, &csv, rows));
+            }
+        }
+        Err(e) => return Err(crate::fsio::IoFailure::new("read", &path, e).into()),
+    }
+    Ok(())
+}
+
+/// A list of sizes as the messages write it: "0.05, 0.1 m".
+fn sizes_text(sizes: &[f64]) -> String {
+    let v: Vec<String> = sizes.iter().map(|d| d.to_string()).collect();
+    format!("{} m", v.join(", "))
 }
 
 /// Combine shard folders of one study into `out` (default: output/<scene>-montecarlo/):
@@ -429,12 +651,20 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
 /// the largest at fewer realisations make one report. Duplicate runs with the same seed are
 /// kept once; the same run with different seeds, or folders of different studies (scene,
 /// overrides, seed), are an error.
-pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffect> {
+///
+/// The folders must hold every run their commands asked for (study_request.json: the
+/// realisations, sizes and shard): a missing shard, a shard that has not finished, or a
+/// size with fewer realisations than asked is named and refused, unless `partial`, which
+/// writes the report of the runs there are and records in size_effect.json that it is
+/// partial and what is missing.
+pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>, partial: bool) -> anyhow::Result<MergeReport> {
     if dirs.is_empty() {
         bail!("merge: give at least one shard folder");
     }
     let mut common: Option<(serde_json::Value, PathBuf)> = None;
     let mut sizes: Vec<f64> = Vec::new();
+    // per folder: its sizes and shard (from study_inputs.json) and requested realisations
+    let mut asked: Vec<(Vec<f64>, Option<Shard>, Option<usize>)> = Vec::new();
     for d in dirs {
         let path = d.join("study_inputs.json");
         let text = std::fs::read_to_string(&path).with_context(|| {
@@ -449,13 +679,35 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
         if v.get("study").and_then(|s| s.as_str()) != Some("montecarlo") {
             bail!("{} is not from a Monte Carlo study", path.display());
         }
+        let shard = match v.get("shard").and_then(|s| s.as_str()) {
+            Some(t) => Some(parse_shard(t).with_context(|| format!("{}: shard", path.display()))?),
+            None => None,
+        };
+        let mut own_sizes = Vec::new();
         // shards, and studies of other sizes (seeds depend on (S, D, r) only), combine
         if let Some(o) = v.as_object_mut() {
             o.insert("shard".into(), serde_json::Value::Null);
             if let Some(list) = o.insert("sizes_m".into(), serde_json::Value::Null) {
-                sizes.extend(serde_json::from_value::<Vec<f64>>(list).unwrap_or_default());
+                own_sizes = serde_json::from_value::<Vec<f64>>(list).unwrap_or_default();
+                sizes.extend(own_sizes.iter().copied());
             }
         }
+        let request = d.join(REQUEST_FILE);
+        let realisations = match std::fs::read_to_string(&request) {
+            Ok(t) => {
+                let r: serde_json::Value = serde_json::from_str(&t)
+                    .with_context(|| format!("cannot read {}", request.display()))?;
+                Some(
+                    r.get("realisations")
+                        .and_then(|n| n.as_u64())
+                        .with_context(|| format!("{}: no realisations", request.display()))?
+                        as usize,
+                )
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(e) => return Err(crate::fsio::IoFailure::new("read", &request, e).into()),
+        };
+        asked.push((own_sizes, shard, realisations));
         match &common {
             None => common = Some((v, path)),
             Some((c, first)) if *c != v => bail!(
@@ -474,23 +726,13 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
     let scene_name = get("scene_name").as_str().unwrap_or("scene").to_string();
     let out =
         out.unwrap_or_else(|| PathBuf::from("output").join(format!("{scene_name}-montecarlo")));
-    if let Ok(text) = std::fs::read_to_string(out.join("study_inputs.json")) {
-        let old: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
-        let mut old_unsharded = old.clone();
-        if let Some(o) = old_unsharded.as_object_mut() {
-            o.insert("shard".into(), serde_json::Value::Null);
-        }
-        if old_unsharded != inputs {
-            bail!(
-                "{} holds another study ({old}); the shards are from {inputs}: use another --out folder or remove it",
-                out.display()
-            );
-        }
-    }
+    check_merge_out(&out, &inputs)?;
     let scene = PathBuf::from(get("scene").as_str().unwrap_or_default());
     let overrides: Vec<String> = serde_json::from_value(get("overrides")).unwrap_or_default();
     let mut merged: [BTreeMap<String, RunRow>; 2] = [BTreeMap::new(), BTreeMap::new()];
-    for d in dirs {
+    let mut folder_missing = Vec::new();
+    let mut notes = Vec::new();
+    for (d, (own_sizes, shard, realisations)) in dirs.iter().zip(&mut asked) {
         let (mc, det) = studies(
             &scene,
             &overrides,
@@ -500,8 +742,19 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
             false,
             RunOutputs::Summary,
         );
+        // per size (µm): realisations of this folder, and whether its deterministic run is here
+        let mut have: BTreeMap<u64, (std::collections::BTreeSet<usize>, bool)> = BTreeMap::new();
         for (k, (study, seed_col)) in [(&mc, 2), (&det, 1)].into_iter().enumerate() {
             for row in study.read_rows()? {
+                let entry = have.entry(size_um(tag_f64(&row, 0))).or_default();
+                match k {
+                    0 => {
+                        if let Ok(r) = row.tags[1].parse::<usize>() {
+                            entry.0.insert(r);
+                        }
+                    }
+                    _ => entry.1 = true,
+                }
                 match merged[k].get(&row.label) {
                     Some(old) if old.tags[seed_col] != row.tags[seed_col] => bail!(
                         "run {} appears with seed {} and with seed {} (in {}): the shards do not belong together",
@@ -517,7 +770,110 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
                 }
             }
         }
+        let n_asked = match realisations {
+            Some(n) => *n,
+            None => {
+                let n = have
+                    .values()
+                    .filter_map(|h| h.0.iter().next_back())
+                    .max()
+                    .map_or(0, |r| r + 1);
+                notes.push(format!(
+                    "{} has no {REQUEST_FILE} (a folder of an older sppm): the realisations it was asked for are taken as {n}, its largest realisation + 1",
+                    d.display()
+                ));
+                *realisations = Some(n);
+                n
+            }
+        };
+        let plan = ShardRuns::new(own_sizes, n_asked, *shard);
+        let det_sizes = plan.deterministic();
+        let what = format!(
+            "{} ({}{} realisations of {})",
+            d.display(),
+            shard.map(|s| format!("shard {s}, ")).unwrap_or_default(),
+            n_asked,
+            sizes_text(own_sizes)
+        );
+        for (i, &dm) in own_sizes.iter().enumerate() {
+            let (reals, det_here) = have.remove(&size_um(dm)).unwrap_or_default();
+            let want = plan.realisations_of(i);
+            let got = reals.iter().filter(|&&r| r < n_asked).count() as u128;
+            if got < want {
+                folder_missing.push(format!(
+                    "{what} holds {got} of the {want} realisations of D = {dm} m it was asked for"
+                ));
+            }
+            if det_sizes.contains(&i) && !det_here {
+                folder_missing.push(format!("{what} lacks the deterministic run of D = {dm} m"));
+            }
+        }
     }
+    // per size: the realisations the folders asked for (the most any asked), against the
+    // distinct realisations there are
+    let mut size_missing = Vec::new();
+    for &dm in &sizes {
+        let um = size_um(dm);
+        let want = dirs
+            .iter()
+            .zip(&asked)
+            .filter(|(_, (s, _, _))| s.iter().any(|x| size_um(*x) == um))
+            .map(|(_, (_, _, n))| n.unwrap_or(0))
+            .max()
+            .unwrap_or(0);
+        let got = merged[0]
+            .values()
+            .filter(|r| size_um(tag_f64(r, 0)) == um)
+            .filter(|r| r.tags[1].parse::<usize>().is_ok_and(|x| x < want))
+            .count();
+        if got < want {
+            size_missing.push(format!("D = {dm} m: {got} of {want} realisations"));
+        }
+        if !merged[1].values().any(|r| size_um(tag_f64(r, 0)) == um) {
+            size_missing.push(format!("D = {dm} m: no deterministic run"));
+        }
+    }
+    let mut missing = Vec::new();
+    if !folder_missing.is_empty() || !size_missing.is_empty() {
+        // name the shards that were not given, per study of n shards and its sizes
+        // (shard count, sizes in µm) → (sizes, the shard numbers given)
+        type Group = (Vec<f64>, std::collections::BTreeSet<usize>);
+        let mut groups: BTreeMap<(usize, Vec<u64>), Group> = BTreeMap::new();
+        for (s, shard, _) in &asked {
+            if let Some(sh) = shard {
+                let key = (sh.n, s.iter().map(|d| size_um(*d)).collect());
+                groups
+                    .entry(key)
+                    .or_insert((s.clone(), Default::default()))
+                    .1
+                    .insert(sh.k);
+            }
+        }
+        for ((n, _), (s, ks)) in groups {
+            let absent: Vec<String> = (1..=n)
+                .filter(|k| !ks.contains(k))
+                .map(|k| format!("{k}/{n}"))
+                .collect();
+            if !absent.is_empty() {
+                missing.push(format!(
+                    "shard{} {} of the study of {} not given",
+                    if absent.len() == 1 { "" } else { "s" },
+                    absent.join(", "),
+                    sizes_text(&s)
+                ));
+            }
+        }
+        missing.extend(folder_missing);
+        missing.extend(size_missing);
+    }
+    if !missing.is_empty() && !partial {
+        bail!(
+            "merge: the folders do not hold the whole study: {}. Give the missing shard folders (or finish a shard by running its command again), or add --partial to write the report of the runs there are",
+            missing.join("; ")
+        );
+    }
+    let lock = crate::fsio::FolderLock::acquire(&out)?;
+    check_merge_out(&out, &inputs)?;
     let [mc_rows, det_rows] = merged.map(|m| m.into_values().collect::<Vec<_>>());
     let (mc, det) = studies(
         &scene,
@@ -530,11 +886,10 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
     );
     mc.write_rows(&mc_rows)?;
     det.write_rows(&det_rows)?;
-    std::fs::write(
-        out.join("study_inputs.json"),
-        serde_json::to_string_pretty(&inputs)? + "\n",
-    )
-    .with_context(|| format!("cannot write {}", out.join("study_inputs.json").display()))?;
+    crate::fsio::write_atomic(
+        &out.join("study_inputs.json"),
+        (serde_json::to_string_pretty(&inputs)? + "\n").as_bytes(),
+    )?;
     let per_size = mc_rows
         .iter()
         .fold(BTreeMap::<u64, usize>::new(), |mut m, r| {
@@ -542,6 +897,16 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
             m
         });
     let realisations = per_size.values().copied().max().unwrap_or(0);
+    let requested = asked.iter().filter_map(|a| a.2).max().unwrap_or(0);
+    crate::fsio::write_atomic(
+        &out.join(REQUEST_FILE),
+        (serde_json::to_string_pretty(&json!({
+            "realisations": requested,
+            "sizes_m": sizes,
+            "shard": null,
+        }))? + "\n")
+            .as_bytes(),
+    )?;
     let meta = json!({
         "scene": get("scene"),
         "scene_name": scene_name,
@@ -552,14 +917,33 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>) -> anyhow::Result<SizeEffec
         "scene_spacing_m": get("scene_spacing_m"),
         "overrides": get("overrides"),
         "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
+        "partial": !missing.is_empty(),
+        "missing": missing,
     });
     let fewest = per_size.values().copied().min().unwrap_or(0);
-    let title = if fewest == realisations {
+    let mut title = if fewest == realisations {
         format!("{scene_name}: size effect, {realisations} realisations")
     } else {
         format!("{scene_name}: size effect, {fewest}–{realisations} realisations per size")
     };
-    report(&out, &mc_rows, &det_rows, meta, &title)
+    if !missing.is_empty() {
+        title.push_str(" (partial)");
+    }
+    let effect = report(&out, &mc_rows, &det_rows, meta, &title)?;
+    drop(lock);
+    let runs = mc_rows.len() + det_rows.len();
+    let completed = mc_rows
+        .iter()
+        .chain(&det_rows)
+        .filter(|r| r.completed())
+        .count();
+    Ok(MergeReport {
+        effect,
+        missing,
+        notes,
+        runs,
+        completed,
+    })
 }
 
 #[cfg(test)]
@@ -603,13 +987,99 @@ mod tests {
         }
     }
 
+    /// The runs of a shard by the definition: every index slot·S + size ≡ k − 1 (mod n),
+    /// listed slot-major.
+    fn shard_items(sizes: usize, realisations: usize, shard: Option<Shard>) -> Vec<Item> {
+        let mut out = Vec::new();
+        for slot in 0..=realisations {
+            for size in 0..sizes {
+                let index = slot * sizes + size;
+                if shard.is_none_or(|s| index % s.n == s.k - 1) {
+                    out.push(Item {
+                        size,
+                        realisation: slot.checked_sub(1),
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// A shard's runs as [`ShardRuns`] makes them: the deterministic runs, then the
+    /// realisations in the order they are taken.
+    fn planned(sizes: &[f64], realisations: usize, shard: Option<Shard>) -> Vec<Item> {
+        let plan = ShardRuns::new(sizes, realisations, shard);
+        let mut v: Vec<Item> = plan
+            .deterministic()
+            .into_iter()
+            .map(|size| Item {
+                size,
+                realisation: None,
+            })
+            .collect();
+        v.extend((0..plan.realisations() as usize).map(|j| plan.realisation(j)));
+        v
+    }
+
+    #[test]
+    fn shard_runs_are_the_definition_largest_size_first() {
+        for ns in 1..=6 {
+            // sizes ascending as parse_sizes returns them; descending too
+            let asc: Vec<f64> = (1..=ns).map(|i| 0.05 * i as f64).collect();
+            let desc: Vec<f64> = asc.iter().rev().copied().collect();
+            for sizes in [asc, desc] {
+                for r in 0..=9 {
+                    for n in 1..=8 {
+                        for k in 1..=n {
+                            let shard = Some(Shard { k, n });
+                            let got = planned(&sizes, r, shard);
+                            let mut want = shard_items(ns, r, shard);
+                            // largest size first, then deterministic, then by realisation
+                            want.sort_by(|a, b| {
+                                (a.realisation.is_some())
+                                    .cmp(&b.realisation.is_some())
+                                    .then(sizes[b.size].total_cmp(&sizes[a.size]))
+                                    .then(a.realisation.cmp(&b.realisation))
+                            });
+                            assert_eq!(got, want, "sizes {sizes:?}, N = {r}, shard {k}/{n}");
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(planned(&[0.1, 0.2], 3, None).len(), 8);
+    }
+
+    #[test]
+    fn shard_runs_of_huge_counts_are_counted_not_listed() {
+        // 2 sizes × (2^64 − 1 + 1) runs over a million shards: 36 893 488 147 420 or …421
+        let plan = ShardRuns::new(&[0.05, 0.1], usize::MAX, Some(Shard { k: 1, n: 1_000_000 }));
+        let total = plan.realisations() + plan.deterministic().len() as u128;
+        let all = 2 * (usize::MAX as u128 + 1);
+        assert_eq!(total, all.div_ceil(1_000_000));
+        // the last shard of 7 of 3 sizes × 4 slots = 12 runs: runs 6 (size 0, slot 2) only
+        let plan = ShardRuns::new(&[0.05, 0.1, 0.2], 3, Some(Shard { k: 7, n: 7 }));
+        assert_eq!(plan.realisations(), 1);
+        assert_eq!(
+            plan.realisation(0),
+            Item {
+                size: 0,
+                realisation: Some(1)
+            }
+        );
+        // a shard beyond the runs is empty
+        let plan = ShardRuns::new(&[0.05], 1, Some(Shard { k: 5, n: 9 }));
+        assert_eq!((plan.realisations(), plan.deterministic().len()), (0, 0));
+    }
+
     #[test]
     fn shards_are_disjoint_and_cover_the_runs() {
-        let all = shard_items(6, 7, None);
+        let sizes = [0.05, 0.1, 0.2, 0.4, 0.8, 1.6];
+        let all = planned(&sizes, 7, None);
         assert_eq!(all.len(), 6 * 8);
         for n in 1..=5 {
             let mut union: Vec<Item> = (1..=n)
-                .flat_map(|k| shard_items(6, 7, Some(Shard { k, n })))
+                .flat_map(|k| planned(&sizes, 7, Some(Shard { k, n })))
                 .collect();
             let len = union.len();
             union.sort();
@@ -621,8 +1091,8 @@ mod tests {
         }
         // adding realisations keeps every earlier run in its shard
         let s = Some(Shard { k: 2, n: 3 });
-        let small = shard_items(6, 3, s);
-        let large = shard_items(6, 9, s);
+        let small = planned(&sizes, 3, s);
+        let large = planned(&sizes, 9, s);
         assert!(small.iter().all(|i| large.contains(i)));
     }
 

@@ -241,20 +241,24 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("output").join(format!("{}-objectivity", base.name())));
-    let mut variants = Vec::new();
-    for &a in &args.angles_deg {
-        for k in 0..=args.offsets {
-            let off = lattice_offset(args.seed, k, a, d.spacing, d.offset);
-            variants.push(Variant {
-                label: label(a, k),
-                overrides: vec![
-                    format!("discretisation.rotation_deg={a:?}"),
-                    format!("discretisation.offset=[{:?}, {:?}]", off[0], off[1]),
-                ],
-                tags: vec![a.to_string(), k.to_string(), args.seed.to_string()],
-            });
+    // runs: angle-major, offset 0 (the scene's own) then the random ones; made when taken
+    let per_angle_runs = args.offsets as u128 + 1;
+    let count = args.angles_deg.len() as u128 * per_angle_runs;
+    let spacing = d.spacing;
+    let scene_offset = d.offset;
+    let make = |j: usize| {
+        let (i, k) = (j as u128 / per_angle_runs, j as u128 % per_angle_runs);
+        let (a, k) = (args.angles_deg[i as usize], k as usize);
+        let off = lattice_offset(args.seed, k, a, spacing, scene_offset);
+        Variant {
+            label: label(a, k),
+            overrides: vec![
+                format!("discretisation.rotation_deg={a:?}"),
+                format!("discretisation.offset=[{:?}, {:?}]", off[0], off[1]),
+            ],
+            tags: vec![a.to_string(), k.to_string(), args.seed.to_string()],
         }
-    }
+    };
     let threshold = args.crack_damage;
     let metrics = move |o: &Outcome| crack_metrics(o, threshold);
     let study = Study {
@@ -276,17 +280,50 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         progress: args.progress,
         outputs: super::runner::RunOutputs::All,
     };
-    let results = study.run(&variants)?;
+    crate::limits::check_count_of(
+        &format!(
+            "--angles {} and --offsets {}: {count} runs ({} angle{} × ({} random offsets + the scene's own))",
+            args.angles_deg
+                .iter()
+                .map(|a| a.to_string())
+                .collect::<Vec<_>>()
+                .join(","),
+            args.offsets,
+            args.angles_deg.len(),
+            if args.angles_deg.len() == 1 { "" } else { "s" },
+            args.offsets
+        ),
+        count as f64,
+        study.bytes_per_run(&base),
+        "runs",
+        "fewer --offsets or --angles",
+    )?;
+    let runs = super::runner::Runs {
+        count: count as usize,
+        variant: &make,
+        // the scene's own offset at each angle
+        probes: (0..args.angles_deg.len())
+            .map(|i| i * per_angle_runs as usize)
+            .collect(),
+    };
+    study.check(&runs)?;
+    let lock = crate::fsio::FolderLock::acquire(&dir)?;
+    let results = study.run(&lock, &runs)?;
 
     let title = format!(
         "{}: force–displacement at every lattice rotation and offset",
         base.name()
     );
-    super::plots::overlay(
-        &title,
-        &results,
-        &|r| format!("θ = {}°, offset {}", r.row.tags[0], r.row.tags[1]),
+    crate::fsio::write_with(
         &dir.join("force_displacement_overlay.svg"),
+        |tmp: &std::path::Path| {
+            super::plots::overlay(
+                &title,
+                &results,
+                &|r| format!("θ = {}°, offset {}", r.row.tags[0], r.row.tags[1]),
+                tmp,
+            )
+        },
     )?;
     let metric = |r: &RunResult, name: &str| {
         let i = CRACK_COLUMNS.iter().position(|c| *c == name).unwrap();
@@ -347,10 +384,11 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         rows: results.iter().map(|r| r.row.clone()).collect(),
         dir: dir.clone(),
     };
-    std::fs::write(
-        dir.join("objectivity.json"),
-        serde_json::to_string_pretty(&report)? + "\n",
+    crate::fsio::write_atomic(
+        &dir.join("objectivity.json"),
+        (serde_json::to_string_pretty(&report)? + "\n").as_bytes(),
     )?;
+    drop(lock);
     Ok(report)
 }
 

@@ -6,15 +6,54 @@
 //! whose label already has a row (resume) and reads those rows back, so an interrupted
 //! study loses nothing. A run that goes unstable (or cannot be set up) is a row with its
 //! status, not the end of the study.
+//!
+//! - **Lazy runs.** A study gives the runner a count and a function from an index to a
+//!   variant ([`Runs`]); the variants are made when a worker takes them, never listed up
+//!   front. The scenes of the first, the last and one variant of each kind ([`Runs::probes`])
+//!   are read before anything runs, so bad input still stops the study at once.
+//! - **Memory.** A study keeps about [`Study::bytes_per_run`] per run (its row, read back
+//!   for the report, and its curve); the studies check their counts against the memory
+//!   budget ([`crate::limits`]) before anything is made.
+//! - **One study per folder.** [`Study::run`] needs the folder's [`FolderLock`], which the
+//!   study takes for its whole length: a second study started into the same folder is
+//!   refused with [`crate::fsio::FolderBusy`].
+//! - **Inputs record.** `study_inputs.json` records what the rows depend on; a folder whose
+//!   rows were made with other inputs, or that holds study rows but no inputs record, is
+//!   refused, never adopted ([`Study::check_inputs`]).
 
+use crate::fsio::{self, FolderLock, IoFailure};
 use crate::run::{Outcome, RunOptions};
 use crate::Scene;
 use anyhow::{bail, Context};
 use serde::Serialize;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
+
+/// The record of a study's inputs in its folder.
+pub const INPUTS_FILE: &str = "study_inputs.json";
+
+/// Memory one run of a study takes while the study runs and reports, besides its curve:
+/// its row (about 450 bytes with its label, tags, status and message) read back from the
+/// CSV, moved into the result list and copied into the study's report, its label in the
+/// done and uniqueness sets, with the maps' overhead.
+pub const ROW_BYTES: f64 = 2048.0;
+
+/// Memory per point of a run's force–displacement curve kept for the overlay plot: the
+/// (displacement, force) pair and the plot's text of it.
+pub const CURVE_POINT_BYTES: f64 = 64.0;
+
+/// The runs of a study, made one at a time from their index (never listed up front).
+pub struct Runs<'a> {
+    pub count: usize,
+    /// Variant of run `k` (0 ≤ k < count), in the order the runs are taken.
+    pub variant: &'a (dyn Fn(usize) -> Variant + Sync),
+    /// Runs whose scenes are read before anything runs, besides the first and the last:
+    /// one of each kind (an angle, a size), so that bad input stops the study at once.
+    pub probes: Vec<usize>,
+}
 
 /// One run of a study: a label (also its folder name and CSV key), the extra overrides
 /// on top of the study's base overrides, and the values of the study's tag columns.
@@ -157,12 +196,11 @@ impl Study<'_> {
         let text = match std::fs::read_to_string(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(vec![]),
-            Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
+            Err(e) => return Err(IoFailure::new("read", &path, e).into()),
         };
         if !text.is_empty() && !text.ends_with('\n') {
             let keep = text.rfind('\n').map(|i| i + 1).unwrap_or(0);
-            std::fs::write(&path, &text[..keep])
-                .with_context(|| format!("cannot repair {}", path.display()))?;
+            fsio::write_atomic(&path, &text.as_bytes()[..keep])?;
             return self.read_rows();
         }
         if text.is_empty() {
@@ -225,35 +263,45 @@ impl Study<'_> {
     /// Write `rows` as a fresh study CSV (replacing the file), in this study's layout.
     pub fn write_rows(&self, rows: &[RunRow]) -> anyhow::Result<()> {
         std::fs::create_dir_all(&self.dir)
-            .with_context(|| format!("cannot create the study folder {}", self.dir.display()))?;
-        let path = self.csv_path();
-        let mut w = csv::Writer::from_path(&path)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        w.write_record(self.header())?;
-        for r in rows {
-            w.write_record(self.record(r))?;
-        }
-        w.flush()
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(())
+            .map_err(|e| IoFailure::new("create the study folder", &self.dir, e))?;
+        fsio::write_with(&self.csv_path(), |tmp: &Path| -> anyhow::Result<()> {
+            let mut w = csv::Writer::from_path(tmp)?;
+            w.write_record(self.header())?;
+            for r in rows {
+                w.write_record(self.record(r))?;
+            }
+            w.flush()?;
+            Ok(())
+        })
     }
 
-    /// Refuse a folder that holds rows of a study with other inputs; record ours.
-    fn check_inputs(&self) -> anyhow::Result<()> {
-        let path = self.dir.join("study_inputs.json");
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            let old: serde_json::Value = serde_json::from_str(&text)
-                .with_context(|| format!("cannot read {}", path.display()))?;
-            if old != self.inputs && self.csv_path().exists() {
-                bail!(
-                    "{} holds a study with other inputs ({old}); this one has {}: use another --out folder or remove it",
-                    self.dir.display(),
-                    self.inputs
-                );
+    /// Refuse a folder that holds study rows made with other inputs, or study rows without
+    /// an inputs record (whose inputs nobody knows); record ours in `study_inputs.json`.
+    pub fn check_inputs(&self) -> anyhow::Result<()> {
+        let path = self.dir.join(INPUTS_FILE);
+        match std::fs::read_to_string(&path) {
+            Ok(text) => {
+                let old: serde_json::Value = serde_json::from_str(&text)
+                    .with_context(|| format!("cannot read {}", path.display()))?;
+                if old != self.inputs && study_rows_in(&self.dir)?.is_some() {
+                    bail!(
+                        "{} holds a study with other inputs ({old}); this one has {}: use another --out folder or remove it",
+                        self.dir.display(),
+                        self.inputs
+                    );
+                }
             }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                if let Some((csv, rows)) = study_rows_in(&self.dir)? {
+                    bail!("{}", no_inputs_record(&self.dir, &csv, rows));
+                }
+            }
+            Err(e) => return Err(IoFailure::new("read", &path, e).into()),
         }
-        std::fs::write(&path, serde_json::to_string_pretty(&self.inputs)? + "\n")
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        fsio::write_atomic(
+            &path,
+            (serde_json::to_string_pretty(&self.inputs)? + "\n").as_bytes(),
+        )?;
         Ok(())
     }
 
@@ -318,77 +366,142 @@ impl Study<'_> {
         Ok(row)
     }
 
+    /// Memory the study keeps per run ([`ROW_BYTES`], and the curve of a run of `scene`
+    /// when every output is written and the curves are read back for the overlay).
+    pub fn bytes_per_run(&self, scene: &Scene) -> f64 {
+        match self.outputs {
+            RunOutputs::All => ROW_BYTES + (scene.output.records + 2) as f64 * CURVE_POINT_BYTES,
+            RunOutputs::Summary => ROW_BYTES,
+        }
+    }
+
+    /// A variant's label and tags as this study needs them.
+    fn check_variant(&self, v: &Variant) -> anyhow::Result<()> {
+        if v.label.is_empty()
+            || v.label.contains(['/', '\\', ',', '"', '\n'])
+            || v.label.starts_with('.')
+        {
+            bail!(
+                "study variant label `{}`: a plain file name is needed",
+                v.label
+            );
+        }
+        if v.tags.len() != self.tag_columns.len() {
+            bail!(
+                "study variant `{}`: {} tags for {} tag columns",
+                v.label,
+                v.tags.len(),
+                self.tag_columns.len()
+            );
+        }
+        Ok(())
+    }
+
+    /// Read the scenes of the first, the last and the probe runs: bad input stops the study
+    /// here, before anything runs (and before the study folder is made). Returns the scene
+    /// of the first run (`None` without runs).
+    pub fn check(&self, runs: &Runs) -> anyhow::Result<Option<Scene>> {
+        if runs.count == 0 {
+            return Ok(None);
+        }
+        let mut probes = vec![0, runs.count - 1];
+        probes.extend(runs.probes.iter().copied());
+        probes.sort_unstable();
+        probes.dedup();
+        let mut first = None;
+        for k in probes {
+            anyhow::ensure!(k < runs.count, "study probe run {k} of {} runs", runs.count);
+            let v = (runs.variant)(k);
+            self.check_variant(&v)?;
+            let scene = self
+                .scene_of(&v)
+                .with_context(|| format!("study variant {}", v.label))?;
+            first.get_or_insert(scene);
+        }
+        Ok(first)
+    }
+
     /// Run every variant that has no row yet, `jobs` at a time, appending each row as its
     /// run finishes; then return all variants' rows (in the order given) with their curves.
-    pub fn run(&self, variants: &[Variant]) -> anyhow::Result<Vec<RunResult>> {
-        let mut seen = std::collections::HashSet::new();
-        for v in variants {
-            if v.label.is_empty()
-                || v.label.contains(['/', '\\', ',', '"', '\n'])
-                || v.label.starts_with('.')
-            {
-                bail!(
-                    "study variant label `{}`: a plain file name is needed",
-                    v.label
-                );
-            }
-            if !seen.insert(v.label.as_str()) {
-                bail!("study variant label `{}` appears twice", v.label);
-            }
-            if v.tags.len() != self.tag_columns.len() {
-                bail!(
-                    "study variant `{}`: {} tags for {} tag columns",
-                    v.label,
-                    v.tags.len(),
-                    self.tag_columns.len()
-                );
+    /// `lock` is the study folder's lock, held by the caller for the whole study.
+    pub fn run(&self, lock: &FolderLock, runs: &Runs) -> anyhow::Result<Vec<RunResult>> {
+        anyhow::ensure!(
+            lock.path() == self.dir.join(fsio::LOCK_FILE),
+            "the study in {} runs under the lock {}",
+            self.dir.display(),
+            lock.path().display()
+        );
+        let count = runs.count;
+        if let Some(first) = self.check(runs)? {
+            // the studies check their counts with their options named; this is the backstop
+            crate::limits::check_count(
+                "study runs",
+                count as f64,
+                self.bytes_per_run(&first),
+                "runs",
+            )?;
+        }
+        std::fs::create_dir_all(&self.dir)
+            .map_err(|e| IoFailure::new("create the study folder", &self.dir, e))?;
+        self.check_inputs()?;
+        let done: HashSet<String> = self.read_rows()?.into_iter().map(|r| r.label).collect();
+        // one pass over the labels (made, checked and dropped one at a time): each once,
+        // and how many runs are still to do
+        let mut pending = 0usize;
+        {
+            let mut seen = HashSet::new();
+            for k in 0..count {
+                let v = (runs.variant)(k);
+                self.check_variant(&v)?;
+                if !done.contains(&v.label) {
+                    pending += 1;
+                }
+                if !seen.insert(v.label) {
+                    bail!(
+                        "study variant label `{}` appears twice",
+                        (runs.variant)(k).label
+                    );
+                }
             }
         }
-        // every scene is read before anything runs: bad input stops the study at once
-        let scenes: Vec<Scene> = variants
-            .iter()
-            .map(|v| {
-                self.scene_of(v)
-                    .with_context(|| format!("study variant {}", v.label))
-            })
-            .collect::<anyhow::Result<_>>()?;
-        std::fs::create_dir_all(&self.dir)
-            .with_context(|| format!("cannot create the study folder {}", self.dir.display()))?;
-        self.check_inputs()?;
-        let done: std::collections::HashSet<String> =
-            self.read_rows()?.into_iter().map(|r| r.label).collect();
-        let pending: Vec<(&Variant, &Scene)> = variants
-            .iter()
-            .zip(&scenes)
-            .filter(|(v, _)| !done.contains(&v.label))
-            .collect();
 
         let path = self.csv_path();
-        let fresh = !path.exists() || std::fs::metadata(&path)?.len() == 0;
+        let fresh = std::fs::metadata(&path)
+            .map(|m| m.len() == 0)
+            .unwrap_or(true);
         let file = std::fs::OpenOptions::new()
             .create(true)
             .append(true)
             .open(&path)
-            .with_context(|| format!("cannot open {}", path.display()))?;
+            .map_err(|e| IoFailure::new("open", &path, e))?;
         let mut writer = csv::WriterBuilder::new().from_writer(file);
+        let append = |w: &mut csv::Writer<std::fs::File>, record: Vec<String>| {
+            w.write_record(record)
+                .map_err(|e| match e.into_kind() {
+                    csv::ErrorKind::Io(io) => IoFailure::new("write", &path, io),
+                    other => {
+                        IoFailure::new("write", &path, std::io::Error::other(format!("{other:?}")))
+                    }
+                })
+                .and_then(|()| w.flush().map_err(|e| IoFailure::new("write", &path, e)))
+        };
         if fresh {
-            writer.write_record(self.header())?;
-            writer.flush()?;
+            append(&mut writer, self.header())?;
         }
         let writer = Mutex::new(writer);
-        let bar = if self.progress && !pending.is_empty() {
-            let b = indicatif::ProgressBar::new(pending.len() as u64);
+        let bar = if self.progress && pending > 0 {
+            let b = indicatif::ProgressBar::new(pending as u64);
             b.set_style(
                 indicatif::ProgressStyle::with_template(
                     "{spinner} {wide_bar} {pos}/{len} runs  {elapsed_precise} ETA {eta}  {msg}",
                 )
                 .unwrap(),
             );
-            if !done.is_empty() {
+            if pending < count {
                 b.println(format!(
                     "{} of {} runs already in {}",
-                    variants.len() - pending.len(),
-                    variants.len(),
+                    count - pending,
+                    count,
                     path.display()
                 ));
             }
@@ -396,9 +509,9 @@ impl Study<'_> {
         } else {
             None
         };
-        // `jobs` worker threads take the pending runs in order. (Not a rayon pool: a rayon
-        // worker waiting for a run's own pool would steal further runs, and more than `jobs`
-        // runs would go at once.)
+        // `jobs` worker threads take the runs in order, each made when it is taken and
+        // skipped if it has a row. (Not a rayon pool: a rayon worker waiting for a run's own
+        // pool would steal further runs, and more than `jobs` runs would go at once.)
         let next = std::sync::atomic::AtomicUsize::new(0);
         let first_error: Mutex<Option<anyhow::Error>> = Mutex::new(None);
         let work = || loop {
@@ -406,16 +519,21 @@ impl Study<'_> {
                 return;
             }
             let k = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-            let Some((v, scene)) = pending.get(k) else {
+            if k >= count {
                 return;
-            };
-            let result = self.run_one(v, scene).and_then(|row| {
-                let mut w = writer.lock().unwrap();
-                w.write_record(self.record(&row))?;
-                w.flush()
-                    .with_context(|| format!("cannot write {}", path.display()))?;
-                Ok(row)
-            });
+            }
+            let v = (runs.variant)(k);
+            if done.contains(&v.label) {
+                continue;
+            }
+            let result = self
+                .scene_of(&v)
+                .with_context(|| format!("study variant {}", v.label))
+                .and_then(|scene| self.run_one(&v, &scene))
+                .and_then(|row| {
+                    append(&mut writer.lock().unwrap(), self.record(&row))?;
+                    Ok(row)
+                });
             match result {
                 Ok(row) => {
                     if let Some(b) = &bar {
@@ -430,7 +548,7 @@ impl Study<'_> {
             }
         };
         std::thread::scope(|s| {
-            for _ in 0..self.jobs.max(1).min(pending.len().max(1)) {
+            for _ in 0..self.jobs.max(1).min(pending.max(1)) {
                 s.spawn(work);
             }
         });
@@ -441,37 +559,82 @@ impl Study<'_> {
             b.finish_and_clear();
         }
         drop(writer);
+        drop(done);
 
-        let rows: HashMap<String, RunRow> = self
+        let mut rows: HashMap<String, RunRow> = self
             .read_rows()?
             .into_iter()
             .map(|r| (r.label.clone(), r))
             .collect();
-        variants
-            .iter()
-            .map(|v| {
-                let row = rows
-                    .get(&v.label)
-                    .cloned()
-                    .with_context(|| format!("{} has no row {}", path.display(), v.label))?;
-                let curve = read_curve(&self.dir.join(&v.label).join("force_displacement.csv"))
-                    .unwrap_or_default();
-                Ok(RunResult { row, curve })
-            })
-            .collect()
+        let mut results = Vec::new();
+        for k in 0..count {
+            let v = (runs.variant)(k);
+            let row = rows
+                .remove(&v.label)
+                .with_context(|| format!("{} has no row {}", path.display(), v.label))?;
+            let curve = match self.outputs {
+                RunOutputs::All => {
+                    read_curve(&self.dir.join(&v.label).join("force_displacement.csv"))
+                        .unwrap_or_default()
+                }
+                RunOutputs::Summary => vec![],
+            };
+            results.push(RunResult { row, curve });
+        }
+        Ok(results)
     }
+}
+
+/// The first study CSV in `dir` (a `*.csv` whose header starts with `label,`) that holds
+/// rows, and its number of rows.
+pub fn study_rows_in(dir: &Path) -> anyhow::Result<Option<(PathBuf, usize)>> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(IoFailure::new("read the folder", dir, e).into()),
+    };
+    let mut names: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "csv") && p.is_file())
+        .collect();
+    names.sort();
+    for path in names {
+        let file = std::fs::File::open(&path).map_err(|e| IoFailure::new("read", &path, e))?;
+        let mut lines = std::io::BufReader::new(file).lines();
+        match lines.next() {
+            Some(Ok(h)) if h.starts_with("label,") => {}
+            _ => continue,
+        }
+        let rows = lines
+            .map_while(Result::ok)
+            .filter(|l| !l.trim().is_empty())
+            .count();
+        if rows > 0 {
+            return Ok(Some((path, rows)));
+        }
+    }
+    Ok(None)
+}
+
+/// Why a folder with study rows but no inputs record is refused.
+pub fn no_inputs_record(dir: &Path, csv: &Path, rows: usize) -> String {
+    format!(
+        "{} holds study rows ({rows} in {}) but no {INPUTS_FILE}, the record of the inputs (scene, overrides, seed) they were made with, so sppm cannot tell whether they belong to this study and does not adopt them: use another --out folder, or remove the folder's study CSVs (or the whole folder {}) to start afresh",
+        dir.display(),
+        csv.display(),
+        dir.display()
+    )
 }
 
 /// Write only a run's summary.json into `dir`.
 fn write_summary(outcome: &Outcome, dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create the output folder {}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| IoFailure::new("create the output folder", dir, e))?;
     let path = dir.join("summary.json");
-    std::fs::write(
+    fsio::write_atomic(
         &path,
-        serde_json::to_string_pretty(&outcome.summary)? + "\n",
-    )
-    .with_context(|| format!("cannot write {}", path.display()))
+        (serde_json::to_string_pretty(&outcome.summary)? + "\n").as_bytes(),
+    )?;
+    Ok(())
 }
 
 /// (displacement_m, force_N) of a run's force_displacement.csv.

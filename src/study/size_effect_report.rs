@@ -6,7 +6,6 @@
 use super::monte_carlo::size_um;
 use super::runner::RunRow;
 use super::size_effect::{fit_bazant, fit_weibull, sample, BazantFit, WeibullFit};
-use anyhow::Context;
 use serde::Serialize;
 use serde_json::json;
 use std::collections::BTreeMap;
@@ -62,6 +61,13 @@ impl SizeEffect {
     pub fn lines(&self) -> Vec<String> {
         let mut l = vec![];
         for s in &self.sizes {
+            if s.n == 0 {
+                l.push(format!(
+                    "D = {} m: no completed realisation ({} failed): no statistics, NaN in size_effect.csv",
+                    s.size_d_m, s.failed
+                ));
+                continue;
+            }
             l.push(format!(
                 "D = {} m: n = {}, mean σN = {:.4} MPa, std {:.4} MPa, CoV {:.4}, deterministic {:.4} MPa{}",
                 s.size_d_m,
@@ -103,6 +109,17 @@ impl SizeEffect {
             ));
         }
         l
+    }
+}
+
+impl SizeEffect {
+    /// Sizes (m) without a completed realisation: their statistics are NaN (null in the JSON).
+    pub fn sizes_without_realisations(&self) -> Vec<f64> {
+        self.sizes
+            .iter()
+            .filter(|s| s.n == 0)
+            .map(|s| s.size_d_m)
+            .collect()
     }
 }
 
@@ -178,30 +195,34 @@ pub fn report(
         sizes,
     };
 
-    let path = dir.join("size_effect.csv");
-    let mut w = csv::Writer::from_path(&path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    w.write_record([
-        "size_D_m",
-        "n",
-        "mean_sigma_N_Pa",
-        "std_sigma_N_Pa",
-        "cov_sigma_N",
-        "deterministic_sigma_N_Pa",
-        "failed",
-    ])?;
-    for s in &effect.sizes {
-        w.write_record([
-            s.size_d_m.to_string(),
-            s.n.to_string(),
-            s.mean_sigma_n_pa.to_string(),
-            s.std_sigma_n_pa.to_string(),
-            s.cov_sigma_n.to_string(),
-            s.deterministic_sigma_n_pa.to_string(),
-            s.failed.to_string(),
-        ])?;
-    }
-    w.flush()?;
+    crate::fsio::write_with(
+        &dir.join("size_effect.csv"),
+        |tmp: &Path| -> anyhow::Result<()> {
+            let mut w = csv::Writer::from_path(tmp)?;
+            w.write_record([
+                "size_D_m",
+                "n",
+                "mean_sigma_N_Pa",
+                "std_sigma_N_Pa",
+                "cov_sigma_N",
+                "deterministic_sigma_N_Pa",
+                "failed",
+            ])?;
+            for s in &effect.sizes {
+                w.write_record([
+                    s.size_d_m.to_string(),
+                    s.n.to_string(),
+                    s.mean_sigma_n_pa.to_string(),
+                    s.std_sigma_n_pa.to_string(),
+                    s.cov_sigma_n.to_string(),
+                    s.deterministic_sigma_n_pa.to_string(),
+                    s.failed.to_string(),
+                ])?;
+            }
+            w.flush()?;
+            Ok(())
+        },
+    )?;
 
     let mut json = json!({
         "sigma_N": "P_max/(0.6*D*t) (dog-bone; P_max/(D*t) with D the body's width otherwise)",
@@ -216,6 +237,7 @@ pub fn report(
             "deterministic_sigma_N_Pa": finite(s.deterministic_sigma_n_pa),
         })).collect::<Vec<_>>(),
         "completed_realisations": effect.completed,
+        "sizes_without_completed_realisations": effect.sizes_without_realisations(),
         "failed_realisations": effect.failed,
         "fits_of_the_means": effect.fits,
         "fits_of_the_deterministic_runs": effect.deterministic_fits,
@@ -227,10 +249,13 @@ pub fn report(
             o.insert(k.clone(), v.clone());
         }
     }
-    let path = dir.join("size_effect.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&json)? + "\n")
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    super::plots::size_effect(title, &effect, &dir.join("size_effect.svg"))?;
+    crate::fsio::write_atomic(
+        &dir.join("size_effect.json"),
+        (serde_json::to_string_pretty(&json)? + "\n").as_bytes(),
+    )?;
+    crate::fsio::write_with(&dir.join("size_effect.svg"), |tmp: &Path| {
+        super::plots::size_effect(title, &effect, tmp)
+    })?;
     Ok(effect)
 }
 
