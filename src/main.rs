@@ -2,8 +2,8 @@
 
 use anyhow::Context;
 use clap::{Parser, Subcommand};
-use sppm::run::{estimated_memory, prepare_with, RunOptions};
 use sppm::fsio::{FolderBusy, IoFailure};
+use sppm::run::{estimated_memory, prepare_with, RunOptions};
 use sppm::{say, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -133,7 +133,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 );
                 say!(
                     "peak force {:.6e} N at {:.6e} m; max kinetic/internal energy {:.3e}",
-                    s.peak_force_n, s.displacement_at_peak_m, s.max_kinetic_to_internal_energy
+                    s.peak_force_n,
+                    s.displacement_at_peak_m,
+                    s.max_kinetic_to_internal_energy
                 );
                 for f in &files {
                     say!("wrote {}", f.display());
@@ -220,7 +222,8 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             }
             say!(
                 "surface corr.    {} of {} boundary particles",
-                p.model.surface.corrected, p.model.surface.boundary_particles
+                p.model.surface.corrected,
+                p.model.surface.boundary_particles
             );
             for d in &sc.derived {
                 say!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const CASES: u32 = 48;
+const CASES: u32 = 64;
 const LIMIT: Duration = Duration::from_secs(4);
 
 const PLATE: &str = r#"
@@ -127,6 +127,13 @@ fn run(args: &[String]) -> (Option<i32>, String, String) {
 /// No panic; exit 0 only with finite results.
 fn judge(args: &[String], out_dir: Option<&Path>) -> Result<(), TestCaseError> {
     let (code, out, err) = run(args);
+    if std::env::var_os("SPPM_FUZZ_VERBOSE").is_some() {
+        eprintln!(
+            "fuzz: {:?} -> {code:?} {}",
+            args,
+            err.lines().next().unwrap_or("")
+        );
+    }
     prop_assert!(
         !err.contains("panicked") && code != Some(101),
         "{args:?} panicked: {err}"
@@ -150,57 +157,69 @@ fn judge(args: &[String], out_dir: Option<&Path>) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-/// Counts as a user might type them: small, large, at the integer limits, or not numbers.
+/// Counts as a user might type them: mostly small, sometimes large, at the integer limits,
+/// or not numbers.
 fn count() -> impl Strategy<Value = String> {
     prop_oneof![
-        (0u64..4).prop_map(|v| v.to_string()),
-        (0u64..1_000_000_000_000).prop_map(|v| v.to_string()),
-        Just(u64::MAX.to_string()),
-        Just(usize::MAX.to_string()),
-        Just("18446744073709551616".to_string()),
-        Just("-1".to_string()),
-        Just("1e9".to_string()),
-        Just("".to_string()),
+        6 => (0u64..4).prop_map(|v| v.to_string()),
+        2 => (0u64..1_000_000_000_000).prop_map(|v| v.to_string()),
+        1 => prop_oneof![
+            Just(u64::MAX.to_string()),
+            Just("18446744073709551616".to_string()),
+            Just("-1".to_string()),
+            Just("1e9".to_string()),
+            Just("".to_string()),
+        ],
     ]
 }
 
-/// Scene values: numbers of every magnitude and sign, non-finite ones, and wrong types.
-fn value() -> impl Strategy<Value = String> {
+/// Scene values: mostly the key's nominal value scaled (0, ±, tiny, huge), sometimes a number
+/// of any magnitude, a non-finite one, or a wrong type.
+fn value(key: usize) -> impl Strategy<Value = String> {
+    let (nominal, integer) = KEYS[key].1;
+    let scaled = prop::sample::select(vec![
+        0.0, -1.0, 1e-3, 0.1, 0.5, 0.9, 1.0, 1.1, 2.0, 10.0, 1e3, 1e9,
+    ])
+    .prop_map(move |f| {
+        if integer {
+            format!("{}", (nominal * f).round() as i64)
+        } else if KEYS[key].0 == "discretisation.offset" {
+            format!("[{:e}, {:e}]", nominal * f, -nominal * f)
+        } else {
+            format!("{:e}", nominal * f)
+        }
+    });
     prop_oneof![
-        any::<f64>().prop_map(|v| format!("{v:e}")),
-        (-3i32..4).prop_map(|e| format!("{}", 10f64.powi(e))),
-        (-1e6f64..1e6).prop_map(|v| v.to_string()),
-        any::<i64>().prop_map(|v| v.to_string()),
-        Just("nan".to_string()),
-        Just("inf".to_string()),
-        Just("-inf".to_string()),
-        Just(u64::MAX.to_string()),
-        Just("\"text\"".to_string()),
-        Just("[1.0, 2.0]".to_string()),
-        Just("true".to_string()),
-        Just("".to_string()),
+        6 => scaled,
+        1 => any::<f64>().prop_map(|v| format!("{v:e}")),
+        1 => any::<i64>().prop_map(|v| v.to_string()),
+        1 => prop::sample::select(vec![
+            "nan", "inf", "-inf", "18446744073709551615", "\"text\"", "[1.0, 2.0]", "true", "",
+        ])
+        .prop_map(String::from),
     ]
 }
 
-const KEYS: [&str; 18] = [
-    "discretisation.spacing",
-    "discretisation.rotation_deg",
-    "discretisation.offset",
-    "material.E",
-    "material.nu",
-    "material.rho",
-    "material.thickness",
-    "loading.end_periods",
-    "loading.ramp_fraction",
-    "solver.safety",
-    "solver.dt",
-    "solver.threads",
-    "damping.internal",
-    "damping.external",
-    "output.records",
-    "groups.top.load.displacement",
-    "seed",
-    "name",
+/// The fuzzed scene keys with a nominal value and whether they are integers.
+const KEYS: [(&str, (f64, bool)); 18] = [
+    ("discretisation.spacing", (0.02, false)),
+    ("discretisation.rotation_deg", (15.0, false)),
+    ("discretisation.offset", (0.003, false)),
+    ("material.E", (30e9, false)),
+    ("material.nu", (0.2, false)),
+    ("material.rho", (2400.0, false)),
+    ("material.thickness", (0.05, false)),
+    ("loading.end_periods", (2.0, false)),
+    ("loading.ramp_fraction", (0.5, false)),
+    ("solver.safety", (0.9, false)),
+    ("solver.dt", (1e-6, false)),
+    ("solver.threads", (1.0, true)),
+    ("damping.internal", (0.2, false)),
+    ("damping.external", (1.0, false)),
+    ("output.records", (50.0, true)),
+    ("groups.top.load.displacement", (1e-5, false)),
+    ("seed", (7.0, true)),
+    ("output.deformed_scale", (100.0, false)),
 ];
 
 proptest! {
@@ -212,10 +231,8 @@ proptest! {
         a in count(),
         b in count(),
         c in count(),
-        key in 0usize..KEYS.len(),
-        v in value(),
-        k2 in 0usize..KEYS.len(),
-        v2 in value(),
+        (key, v) in (0usize..KEYS.len()).prop_flat_map(|k| (Just(k), value(k))),
+        (k2, v2) in (0usize..KEYS.len()).prop_flat_map(|k| (Just(k), value(k))),
         case in 0u64..u64::MAX,
     ) {
         let out = dir().join(format!("out-{case}"));
@@ -229,9 +246,9 @@ proptest! {
                       s("--seed"), b, s("--shard"), format!("{}/{}", c, a_or(&c)), s("--jobs"), s("1"),
                       s("--quiet"), s("--out"), o.clone()],
             3 => vec![s("run"), scene("plate.toml", PLATE), s("--quiet"), s("--out"), o.clone(),
-                      s("--set"), format!("{}={v}", KEYS[key]), s("--set"), format!("{}={v2}", KEYS[k2])],
+                      s("--set"), format!("{}={v}", KEYS[key].0), s("--set"), format!("{}={v2}", KEYS[k2].0)],
             _ => vec![s("check"), scene("plate.toml", PLATE),
-                      s("--set"), format!("{}={v}", KEYS[key]), s("--set"), format!("{}={v2}", KEYS[k2])],
+                      s("--set"), format!("{}={v}", KEYS[key].0), s("--set"), format!("{}={v2}", KEYS[k2].0)],
         };
         let r = judge(&args, Some(&out));
         let _ = std::fs::remove_dir_all(&out);

@@ -103,7 +103,11 @@ fn an_endless_scene_file_is_refused_without_reading_it_all() {
         "check /dev/zero",
     );
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("at most 1048576 bytes"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("at most 1048576 bytes"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 // ---- 3: relaxation that did not converge ----
@@ -127,7 +131,10 @@ fn relaxation_whose_increments_did_not_converge_says_so_and_fails() {
         let s = summary(&out);
         assert_eq!(s["status"], "unconverged", "{key}");
         assert!(s["unconverged_increments"].as_u64().unwrap() > 0);
-        assert!(s["message"].as_str().unwrap().contains("solver.max_residual"));
+        assert!(s["message"]
+            .as_str()
+            .unwrap()
+            .contains("solver.max_residual"));
         let _ = std::fs::remove_dir_all(&out);
     }
 }
@@ -152,10 +159,7 @@ fn an_unconverged_residual_accepted_by_the_scene_passes_with_a_warning() {
         }
     }
     // max_residual below the tolerance is not a meaningful acceptance
-    let o = relaxation_block(
-        &out,
-        &["solver.tolerance=1e-3", "solver.max_residual=1e-4"],
-    );
+    let o = relaxation_block(&out, &["solver.tolerance=1e-3", "solver.max_residual=1e-4"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("solver.max_residual"), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&out);
@@ -257,7 +261,11 @@ fn a_folder_holds_one_run_only() {
     let out = tmp("stale");
     std::fs::create_dir_all(&out).unwrap();
     // files an earlier run of another scene left, a half-written file, and the user's own
-    for f in ["crack_map.svg", "random_field_ft.svg", ".particles.csv.partial"] {
+    for f in [
+        "crack_map.svg",
+        "random_field_ft.svg",
+        ".particles.csv.partial",
+    ] {
         std::fs::write(out.join(f), "stale").unwrap();
     }
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
@@ -282,7 +290,10 @@ fn a_folder_holds_one_run_only() {
         assert!(!out.join(f).exists(), "{f} is still in the folder");
     }
     assert!(out.join("summary.json").exists() && out.join("particles.csv").exists());
-    assert_eq!(std::fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -315,7 +326,10 @@ fn a_write_that_fails_leaves_no_truncated_file_and_no_summary() {
         .unwrap();
     assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
     let e = stderr(&o);
-    assert!(e.contains(out.to_str().unwrap()), "the message names the file: {e}");
+    assert!(
+        e.contains(out.to_str().unwrap()),
+        "the message names the file: {e}"
+    );
     assert!(
         !out.join("summary.json").exists(),
         "a summary beside an unfinished write"
@@ -472,9 +486,10 @@ fn minor_inputs_are_refused_in_the_scenes_words() {
         assert!(e.contains(needle), "{args:?}: expected `{needle}` in: {e}");
         assert!(!e.contains("Box {") && !e.contains("invalid type"), "{e}");
     }
-    assert!(
-        !Path::new(env!("CARGO_MANIFEST_DIR")).join("output/..").join("summary.json").exists()
-    );
+    assert!(!Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("output/..")
+        .join("summary.json")
+        .exists());
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -489,7 +504,12 @@ fn check_of_a_large_body_reports_its_stages() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let e = stderr(&o);
-    for stage in ["filling the body", "fundamental period", "stable time step", "timing"] {
+    for stage in [
+        "filling the body",
+        "fundamental period",
+        "stable time step",
+        "timing",
+    ] {
         assert!(e.contains(stage), "no `{stage}` in: {e}");
     }
     // a small body stays quiet
@@ -499,8 +519,8 @@ fn check_of_a_large_body_reports_its_stages() {
 
 #[test]
 fn the_readme_names_the_particles_csv_columns_sppm_writes() {
-    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
-        .unwrap();
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
     let line = readme
         .lines()
         .find(|l| l.starts_with("| `particles.csv`"))
@@ -509,7 +529,10 @@ fn the_readme_names_the_particles_csv_columns_sppm_writes() {
         .iter()
         .chain(sppm::output::csv::DAMAGE_COLUMNS.iter())
     {
-        assert!(line.contains(&format!("`{c}`")), "README lacks `{c}`: {line}");
+        assert!(
+            line.contains(&format!("`{c}`")),
+            "README lacks `{c}`: {line}"
+        );
     }
     assert!(!line.contains("`w_t`") && !line.contains("`w_c`"));
 }

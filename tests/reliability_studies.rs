@@ -46,6 +46,8 @@ select = { by = "edge", edge = "top", rows = 2 }
 load = { component = "y", displacement = 0.5e-3 }
 [solver]
 method = "relaxation"
+# the scene of tests/montecarlo.rs: 1–2% out of balance at a few post-peak increments
+max_residual = 0.05
 [loading]
 stop_after_peak = 0.8
 "#;
@@ -369,11 +371,7 @@ fn a_merge_names_missing_shards_and_runs_and_needs_partial() {
     let lock = sppm::fsio::FolderLock::acquire(&merged).unwrap();
     let o = merge(&[&s1, &s2], &["--partial"]);
     let err = text(&o).1;
-    assert!(
-        matches!(o.status.code(), Some(5) | Some(2)),
-        "{:?} {err}",
-        o.status
-    );
+    assert!(o.status.code() == Some(5), "{:?} {err}", o.status);
     assert!(
         err.contains(&format!(
             "{} is in use by another sppm process (process {}:",
@@ -520,9 +518,9 @@ fn a_second_study_into_a_busy_folder_is_refused() {
     );
 
     let err = text(&second).1;
-    // FolderBusy: exit status 5 once src/main.rs maps it (2, as any error, before)
+    // FolderBusy: exit status 5
     assert!(
-        matches!(second.status.code(), Some(5) | Some(2)),
+        second.status.code() == Some(5),
         "the second study was not refused: {:?} {err}",
         second.status
     );

@@ -133,7 +133,13 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
             // particles L0/2 apart in depth) the depth cut alone takes every other lattice
             // line; peel `rows` layers off the surface as well, so that every lattice line
             // reaching the edge gives its `rows` outermost particles.
-            peel_layers(p, n, *rows, hmax - (*rows as f64 + 0.5) * p.spacing, &mut chosen);
+            peel_layers(
+                p,
+                n,
+                *rows,
+                hmax - (*rows as f64 + 0.5) * p.spacing,
+                &mut chosen,
+            );
             (0..p.len())
                 .filter(|&i| chosen[i])
                 .map(|i| i as u32)
@@ -205,7 +211,10 @@ mod tests {
                             .iter()
                             .filter(|&&i| (p.x0[i as usize].y / 1e-6).round() as i64 == *y)
                             .count();
-                        assert_eq!(in_row, rows as usize, "{edge:?} rows = {rows}, row y = {y} µm");
+                        assert_eq!(
+                            in_row, rows as usize,
+                            "{edge:?} rows = {rows}, row y = {y} µm"
+                        );
                     }
                 }
             }

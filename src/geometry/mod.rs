@@ -194,7 +194,15 @@ pub fn polygon_self_intersects(v: &[Vector2<f64>]) -> bool {
     let cross = |o: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>| {
         (a - o).x * (b - o).y - (a - o).y * (b - o).x
     };
-    let sign = |c: f64| if c > eps { 1 } else if c < -eps { -1 } else { 0 };
+    let sign = |c: f64| {
+        if c > eps {
+            1
+        } else if c < -eps {
+            -1
+        } else {
+            0
+        }
+    };
     // q lies on the segment a–b (given that the three are collinear)
     let within = |a: Vector2<f64>, b: Vector2<f64>, q: Vector2<f64>| {
         q.x >= a.x.min(b.x) - eps.sqrt()
@@ -244,15 +252,32 @@ mod tests {
         };
         let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
         assert!(!polygon_self_intersects(&p(&square)));
-        let l_shape = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]];
+        let l_shape = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ];
         assert!(!polygon_self_intersects(&p(&l_shape)));
         // the square's outline traversed twice
         let twice: Vec<[f64; 2]> = square.iter().chain(square.iter()).copied().collect();
         assert!(polygon_self_intersects(&p(&twice)));
         // a bow tie (proper crossing)
-        assert!(polygon_self_intersects(&p(&[[0.0, 0.0], [1.0, 1.0], [1.0, 0.0], [0.0, 1.0]])));
+        assert!(polygon_self_intersects(&p(&[
+            [0.0, 0.0],
+            [1.0, 1.0],
+            [1.0, 0.0],
+            [0.0, 1.0]
+        ])));
         // a vertex on another edge, and an edge that doubles back
-        assert!(polygon_self_intersects(&p(&[[0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [1.0, 1.0]])));
+        assert!(polygon_self_intersects(&p(&[
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 1.0]
+        ])));
         assert!(polygon_self_intersects(&p(&[
             [0.0, 0.0],
             [2.0, 0.0],

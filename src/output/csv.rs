@@ -37,7 +37,8 @@ pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
 }
 
 /// Columns of particles.csv (README, "Outputs").
-pub const PARTICLE_COLUMNS: [&str; 7] = ["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];
+pub const PARTICLE_COLUMNS: [&str; 7] =
+    ["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];
 
 /// Columns particles.csv adds for scenes with damage: w_t, w_c and yielded (0 or 1).
 pub const DAMAGE_COLUMNS: [&str; 3] = ["tensile_damage", "compressive_damage", "yielded"];

@@ -63,18 +63,19 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
         Err(e) => return Err(fsio::IoFailure::new("remove the old", &summary, e).into()),
     }
     let mut files = Vec::new();
-    let mut put = |name: String,
-                   write: &dyn Fn(&Path) -> anyhow::Result<()>|
-     -> anyhow::Result<()> {
-        let f = dir.join(name);
-        fsio::write_with(&f, write)?;
-        files.push(f);
-        Ok(())
-    };
+    let mut put =
+        |name: String, write: &dyn Fn(&Path) -> anyhow::Result<()>| -> anyhow::Result<()> {
+            let f = dir.join(name);
+            fsio::write_with(&f, write)?;
+            files.push(f);
+            Ok(())
+        };
     put("force_displacement.csv".into(), &|f| {
         csv::write_records(&outcome.records, f)
     })?;
-    put("particles.csv".into(), &|f| csv::write_particles(outcome, f))?;
+    put("particles.csv".into(), &|f| {
+        csv::write_particles(outcome, f)
+    })?;
     put("force_displacement.svg".into(), &|f| {
         plots::force_displacement(outcome, f)
     })?;
@@ -96,7 +97,9 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
         })?;
     }
     if o.vtk {
-        put("particles.vtk".into(), &|f| vtk::write_particles(outcome, f))?;
+        put("particles.vtk".into(), &|f| {
+            vtk::write_particles(outcome, f)
+        })?;
     }
     remove_stale(dir, &files)?;
     write_summary(outcome, dir)?;
@@ -125,7 +128,8 @@ fn remove_stale(dir: &Path, keep: &[PathBuf]) -> anyhow::Result<()> {
             && is_run_file(&name[1..name.len() - ".partial".len()]);
         if (is_run_file(&name) || partial) && !keep.contains(&entry.path()) {
             let p = entry.path();
-            std::fs::remove_file(&p).map_err(|e| fsio::IoFailure::new("remove the stale", &p, e))?;
+            std::fs::remove_file(&p)
+                .map_err(|e| fsio::IoFailure::new("remove the stale", &p, e))?;
         }
     }
     Ok(())

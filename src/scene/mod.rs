@@ -422,7 +422,10 @@ impl Selection {
             .collect();
         // `by` first, as a scene writes it
         items.sort_by_key(|s| !s.starts_with("by ="));
-        format!("{{ {} }}", items.join(", ").replace(",", ", ").replace(",  ", ", "))
+        format!(
+            "{{ {} }}",
+            items.join(", ").replace(",", ", ").replace(",  ", ", ")
+        )
     }
 }
 

@@ -489,7 +489,7 @@ impl Scene {
                 return Err(invalid(
                     "solver.max_residual",
                     r,
-                    &format!("must satisfy solver.tolerance = {} ≤ max_residual < 1 (the out-of-balance ratio accepted for an increment that stops at solver.max_iterations)", s.tolerance),
+                    format!("must satisfy solver.tolerance = {} ≤ max_residual < 1 (the out-of-balance ratio accepted for an increment that stops at solver.max_iterations)", s.tolerance),
                 ));
             }
         }

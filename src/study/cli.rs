@@ -164,9 +164,9 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 jobs: jobs.unwrap_or_else(default_jobs),
                 progress: !quiet,
             })?;
-            println!("{}", report.spread_line());
+            crate::say!("{}", report.spread_line());
             if !quiet {
-                println!("wrote {}", report.dir.display());
+                crate::say!("wrote {}", report.dir.display());
             }
             Ok(status(report.completed, report.runs))
         }
@@ -190,10 +190,10 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 progress: !quiet,
             })?;
             for l in report.lines() {
-                println!("{l}");
+                crate::say!("{l}");
             }
             if !quiet {
-                println!("wrote {}", report.dir.display());
+                crate::say!("wrote {}", report.dir.display());
             }
             Ok(status(report.completed, report.runs))
         }
@@ -228,18 +228,18 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
             match &report.size_effect {
                 Some(effect) => {
                     for l in effect.lines() {
-                        println!("{l}");
+                        crate::say!("{l}");
                     }
                     empty = effect.sizes_without_realisations();
                 }
-                None => println!(
+                None => crate::say!(
                     "shard done: {} runs in {} (combine the shards with `sppm study merge`)",
                     report.runs,
                     report.dir.display()
                 ),
             }
             if !quiet {
-                println!("wrote {}", report.dir.display());
+                crate::say!("wrote {}", report.dir.display());
             }
             no_data(&empty, "realisations.csv");
             Ok(status(report.completed, report.runs))
@@ -256,9 +256,9 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 );
             }
             for l in merged.effect.lines() {
-                println!("{l}");
+                crate::say!("{l}");
             }
-            println!("wrote {}", merged.effect.dir.display());
+            crate::say!("wrote {}", merged.effect.dir.display());
             no_data(
                 &merged.effect.sizes_without_realisations(),
                 "realisations.csv",
