@@ -31,6 +31,21 @@ fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
 }
 
+/// `sppm run` of the shipped plate into `out`, quietly, with `--set` overrides.
+fn plate(out: &Path, sets: &[&str]) -> Output {
+    let mut args = vec![
+        "run",
+        "lattices/elastic_plate.toml",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    for v in sets {
+        args.extend(["--set", v]);
+    }
+    sppm(&args)
+}
+
 /// Wait for a child at most `limit`; kill it and fail if it is still running then.
 fn wait_at_most(mut child: std::process::Child, limit: Duration, what: &str) -> Output {
     let start = Instant::now();
@@ -171,17 +186,13 @@ fn an_unconverged_residual_accepted_by_the_scene_passes_with_a_warning() {
 fn energy_put_into_the_dampers_from_nowhere_stops_the_run() {
     // the run: 1.7e10 J in the dampers for 4.7e6 J of work, reported "completed"
     let out = tmp("energy");
-    let o = sppm(&[
-        "run",
-        "lattices/elastic_plate.toml",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "discretisation.spacing=0.01",
-        "--set",
-        "groups.top.load.displacement=0.1",
-    ]);
+    let o = plate(
+        &out,
+        &[
+            "discretisation.spacing=0.01",
+            "groups.top.load.displacement=0.1",
+        ],
+    );
     assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
     let e = stderr(&o);
     assert!(e.contains("energy balance"), "{e}");
@@ -203,15 +214,7 @@ fn energy_put_into_the_dampers_from_nowhere_stops_the_run() {
 fn a_normal_run_keeps_its_energy_balance() {
     // the guard does not stop the shipped plate, and its balance closes: W ≈ K + U + D
     let out = tmp("energy-ok");
-    let o = sppm(&[
-        "run",
-        "lattices/elastic_plate.toml",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "discretisation.spacing=0.005",
-    ]);
+    let o = plate(&out, &["discretisation.spacing=0.005"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let s = summary(&out);
     let w = s["external_work_J"].as_f64().unwrap();
@@ -269,17 +272,7 @@ fn a_folder_holds_one_run_only() {
         std::fs::write(out.join(f), "stale").unwrap();
     }
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
-    let o = sppm(&[
-        "run",
-        "lattices/elastic_plate.toml",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "discretisation.spacing=0.01",
-        "--set",
-        "output.vtk=false",
-    ]);
+    let o = plate(&out, &["discretisation.spacing=0.01", "output.vtk=false"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     for f in [
         "crack_map.svg",
@@ -382,15 +375,7 @@ fn a_second_run_into_a_busy_folder_is_refused_naming_the_first() {
         stderr(&o)
     );
     // a killed holder leaves no stale lock: the folder is free again
-    let o = sppm(&[
-        "run",
-        "lattices/elastic_plate.toml",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "discretisation.spacing=0.01",
-    ]);
+    let o = plate(&out, &["discretisation.spacing=0.01"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&out);
 }

@@ -13,44 +13,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// The dog-bone of tests/montecarlo.rs (D0 = 0.1 m, L0 = 8 mm, an f't random field).
-const DOGBONE: &str = r#"
-name = "tiny_dogbone"
-[body]
-shape = "dogbone"
-size = 0.1
-[discretisation]
-spacing = 0.008
-[material]
-nu = 0.2
-rho = 2183.0
-thickness = 0.1
-[concrete]
-preset = "splm_dogbone"
-[[random_field]]
-property = "ft"
-correlation = "exponential"
-length = 0.016
-marginal = "normal"
-cov = 0.1
-[[groups]]
-name = "bottom"
-select = { by = "edge", edge = "bottom", rows = 2 }
-fix = ["y"]
-[[groups]]
-name = "anchor"
-select = { by = "nearest", point = [0.0, 0.0] }
-fix = ["x"]
-[[groups]]
-name = "top"
-select = { by = "edge", edge = "top", rows = 2 }
-load = { component = "y", displacement = 0.5e-3 }
-[solver]
-method = "relaxation"
-# the scene of tests/montecarlo.rs: 1–2% out of balance at a few post-peak increments
-max_residual = 0.05
-[loading]
-stop_after_peak = 0.8
-"#;
+const DOGBONE: &str = common::TINY_DOGBONE;
 
 /// The shipped tension block at L0 = 30 mm.
 const TINY: [&str; 2] = ["--set", "discretisation.spacing=0.03"];
