@@ -43,7 +43,7 @@ pub struct FolderBusy {
     pub holder: String,
 }
 
-/// The temporary name a file is written under before [`publish`] renames it.
+/// The temporary name a file is written under before it is renamed into place.
 pub fn partial_path(path: &Path) -> PathBuf {
     let name = path
         .file_name()
@@ -53,97 +53,70 @@ pub fn partial_path(path: &Path) -> PathBuf {
 }
 
 /// Flush `partial` to disk and rename it to `path` (replacing what was there).
-pub fn publish(partial: &Path, path: &Path) -> Result<(), IoFailure> {
+fn publish(partial: &Path, path: &Path) -> Result<(), IoFailure> {
     let f = File::open(partial).map_err(|e| IoFailure::new("write", path, e))?;
     f.sync_all().map_err(|e| IoFailure::new("write", path, e))?;
-    std::fs::rename(partial, path).map_err(|e| {
-        let _ = std::fs::remove_file(partial);
-        IoFailure::new("write", path, e)
-    })
+    std::fs::rename(partial, path).map_err(|e| IoFailure::new("write", path, e))
 }
 
-/// Write `path` through `fill`, which writes the whole content to the file it is given
-/// (a temporary one); then publish it. On any failure the temporary file is removed and the
-/// old `path`, if any, is left as it was.
-pub fn write_with<E>(
+/// Run `write` on the temporary file of `path` and publish it; on any failure remove the
+/// temporary file (the old `path`, if any, is left as it was).
+fn through_partial(
     path: &Path,
-    fill: impl FnOnce(&Path) -> Result<(), E>,
-) -> Result<(), anyhow::Error>
-where
-    E: Into<anyhow::Error>,
-{
+    write: impl FnOnce(&Path) -> Result<(), IoFailure>,
+) -> Result<(), IoFailure> {
     let partial = partial_path(path);
-    let result = fill(&partial)
-        .map_err(|e| {
-            let e: anyhow::Error = e.into();
-            // an I/O error deep in a writer (a plot, the CSV writer) becomes an IoFailure
-            // naming the final file
-            match find_io(&e) {
-                Some(kind) => anyhow::Error::new(IoFailure::new(
-                    "write",
-                    path,
-                    std::io::Error::new(kind, format!("{e:#}")),
-                )),
-                None => e.context(format!("cannot write {}", path.display())),
-            }
-        })
-        .and_then(|()| publish(&partial, path).map_err(anyhow::Error::new));
+    let result = write(&partial).and_then(|()| publish(&partial, path));
     if result.is_err() {
         let _ = std::fs::remove_file(&partial);
     }
     result
 }
 
-/// The kind of the first I/O error in an error's chain (also inside plotters' and csv's own
-/// error types, which keep the `std::io::Error` as their source or in their text).
-fn find_io(e: &anyhow::Error) -> Option<std::io::ErrorKind> {
-    for cause in e.chain() {
-        if let Some(io) = cause.downcast_ref::<std::io::Error>() {
-            return Some(io.kind());
-        }
-        if let Some(c) = cause.downcast_ref::<csv::Error>() {
-            if let csv::ErrorKind::Io(io) = c.kind() {
-                return Some(io.kind());
-            }
-        }
-    }
-    let text = format!("{e:#}");
-    [
-        "No space left",
-        "File too large",
-        "Permission denied",
-        "Read-only file system",
-        "Disk quota",
-    ]
-    .iter()
-    .any(|s| text.contains(s))
-    .then_some(std::io::ErrorKind::Other)
+/// Write `path` through `fill`, which writes the whole content to the file it is given
+/// (a temporary one); then publish it. Whatever stops `fill` (the disk, a plot's backend,
+/// the CSV writer) is an [`IoFailure`] naming `path`: the output could not be written.
+pub fn write_with<E>(
+    path: &Path,
+    fill: impl FnOnce(&Path) -> Result<(), E>,
+) -> Result<(), IoFailure>
+where
+    E: Into<anyhow::Error>,
+{
+    through_partial(path, |partial| {
+        fill(partial).map_err(|e| {
+            let e: anyhow::Error = e.into();
+            let kind = e
+                .chain()
+                .find_map(|c| c.downcast_ref::<std::io::Error>().map(|io| io.kind()))
+                .unwrap_or(std::io::ErrorKind::Other);
+            IoFailure::new("write", path, std::io::Error::new(kind, format!("{e:#}")))
+        })
+    })
 }
 
 /// Write `bytes` to `path` atomically (temporary file, flush, rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoFailure> {
-    let partial = partial_path(path);
-    let result = (|| {
-        let mut f = File::create(&partial)?;
-        f.write_all(bytes)?;
-        f.sync_all()
-    })()
-    .map_err(|e| IoFailure::new("write", path, e))
-    .and_then(|()| publish(&partial, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&partial);
-    }
-    result
+    through_partial(path, |partial| {
+        std::fs::write(partial, bytes).map_err(|e| IoFailure::new("write", path, e))
+    })
 }
 
-/// Create `dir` (and its parents) and check that files can be written in it, before any
-/// compute is spent.
-pub fn ensure_writable_folder(dir: &Path) -> Result<(), IoFailure> {
-    std::fs::create_dir_all(dir).map_err(|e| IoFailure::new("create the folder", dir, e))?;
-    let probe = dir.join(format!(".sppm-write-test-{}", std::process::id()));
-    let r = File::create(&probe).and_then(|mut f| f.write_all(b"sppm"));
-    let _ = std::fs::remove_file(&probe);
-    r.map_err(|e| IoFailure::new("write in the folder", dir, e))
+/// Write `value` as pretty JSON with a final newline to `path`, atomically.
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    write_atomic(
+        path,
+        (serde_json::to_string_pretty(value)? + "\n").as_bytes(),
+    )?;
+    Ok(())
+}
+
+/// A CSV writer's failure on `path` as an [`IoFailure`].
+pub fn csv_failure(path: &Path, e: csv::Error) -> IoFailure {
+    match e.into_kind() {
+        csv::ErrorKind::Io(io) => IoFailure::new("write", path, io),
+        other => IoFailure::new("write", path, std::io::Error::other(format!("{other:?}"))),
+    }
 }
 
 /// The lock of one folder, held until dropped (or until the process ends).
@@ -158,7 +131,9 @@ pub const LOCK_FILE: &str = ".sppm.lock";
 
 impl FolderLock {
     /// Create `dir` if needed and take its lock without waiting. A folder locked by another
-    /// process is refused with [`FolderBusy`] naming that process.
+    /// process is refused with [`FolderBusy`] naming that process. Writing the holder's
+    /// record into the lock file also proves that files can be written in the folder, before
+    /// any compute is spent (`sppm run` takes the lock before it sets the scene up).
     pub fn acquire(dir: &Path) -> anyhow::Result<FolderLock> {
         std::fs::create_dir_all(dir).map_err(|e| IoFailure::new("create the folder", dir, e))?;
         let path = dir.join(LOCK_FILE);

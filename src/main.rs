@@ -115,8 +115,8 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 anyhow::bail!("--threads 0: at least 1 worker thread is needed");
             }
             let dir = out.unwrap_or_else(|| PathBuf::from("output").join(sc.name()));
-            // the folder is checked, created and locked before any compute is spent
-            let _folder = sppm::output::RunFolder::open(&dir)?;
+            // the folder is created, locked and so known to be writable before any compute
+            let _lock = sppm::fsio::FolderLock::acquire(&dir)?;
             let outcome = sppm::run(
                 &sc,
                 &RunOptions {
@@ -141,18 +141,16 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     say!("wrote {}", f.display());
                 }
             }
-            if let (Some(k), Some(r), false) = (
+            if let (Some(k @ 1..), Some(r), false) = (
                 s.unconverged_increments,
                 s.max_final_residual,
                 outcome.failed(),
             ) {
-                if k > 0 {
-                    eprintln!(
-                        "warning: {k} of {} load increments stopped at solver.max_iterations with an out-of-balance force up to {r:.3e} × the reactions (accepted by solver.max_residual = {:e})",
-                        s.increments.unwrap_or(0),
-                        sc.solver.max_residual.unwrap_or(sc.solver.tolerance)
-                    );
-                }
+                eprintln!(
+                    "warning: {k} of {} load increments stopped at solver.max_iterations with an out-of-balance force up to {r:.3e} × the reactions (accepted by solver.max_residual = {:e})",
+                    s.increments.unwrap_or(0),
+                    sc.solver.max_residual.unwrap_or(sc.solver.tolerance)
+                );
             }
             if outcome.failed() {
                 eprintln!("error: {}", s.message.clone().unwrap_or_default());

@@ -142,6 +142,7 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
     let mut groups = Vec::new();
     let mut constrained = vec![[false; 2]; n];
     let mut amplitude: Vec<[Option<(f64, String)>; 2]> = vec![[None, None]; n];
+    let (body_lo, body_hi) = shape.bounding_box();
     for g in &scene.groups {
         let members = groups::select(&g.select, &particles, &shape);
         if members.is_empty() {
@@ -149,12 +150,8 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
                 key: format!("groups.{}.select", g.name),
                 value: g.select.scene_text(),
                 allowed: format!(
-                    "a selection that contains at least one particle; the body's {} particles lie in x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m at this spacing, rotation and offset",
-                    particles.len(),
-                    particles.x0.iter().map(|x| x.x).fold(f64::INFINITY, f64::min),
-                    particles.x0.iter().map(|x| x.x).fold(f64::NEG_INFINITY, f64::max),
-                    particles.x0.iter().map(|x| x.y).fold(f64::INFINITY, f64::min),
-                    particles.x0.iter().map(|x| x.y).fold(f64::NEG_INFINITY, f64::max),
+                    "a selection that contains at least one particle; the body spans x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m",
+                    body_lo.x, body_hi.x, body_lo.y, body_hi.y
                 ),
             }));
         }
@@ -246,9 +243,8 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
     // concrete values go to the damage kernel (`build_simulation`).
     // The box is widened by a margin that does not depend on the spacing (particles may sit
     // on the outline within the lattice fill's tolerance, 1e-9·size).
-    let (lo, hi) = shape.bounding_box();
     let pad = Vector2::repeat(1e-6 * shape.size().max(1.0));
-    let fields = properties::sample(scene, lo - pad, hi + pad, &particles.x0)?;
+    let fields = properties::sample(scene, body_lo - pad, body_hi + pad, &particles.x0)?;
     properties::check_strengths(scene, &fields)?;
     if let Some(f) = properties::stiffness_factors(&fields, m.youngs_modulus()) {
         for i in 0..n {

@@ -4,11 +4,11 @@
 //! given a few seconds (a huge but acceptable count simply runs; it is stopped there), so
 //! the fuzzer's time is bounded: at most CASES × LIMIT.
 
+mod common;
 use proptest::prelude::*;
-use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 const CASES: u32 = 64;
 const LIMIT: Duration = Duration::from_secs(4);
@@ -38,40 +38,7 @@ load = { component = "y", displacement = 1.0e-5 }
 end_periods = 2.0
 "#;
 
-const DOGBONE: &str = r#"
-name = "fuzz_dogbone"
-[body]
-shape = "dogbone"
-size = 0.05
-[discretisation]
-spacing = 0.01
-[material]
-nu = 0.2
-rho = 2183.0
-thickness = 0.1
-[concrete]
-preset = "splm_dogbone"
-[[random_field]]
-property = "ft"
-correlation = "exponential"
-length = 0.02
-marginal = "normal"
-cov = 0.1
-[[groups]]
-name = "bottom"
-select = { by = "edge", edge = "bottom", rows = 1 }
-fix = ["x", "y"]
-[[groups]]
-name = "top"
-select = { by = "edge", edge = "top", rows = 1 }
-load = { component = "y", displacement = 0.5e-3 }
-[solver]
-method = "relaxation"
-increments = 20
-max_residual = 0.5
-[loading]
-stop_after_peak = 0.8
-"#;
+const DOGBONE: &str = common::TINY_DOGBONE;
 
 fn dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("sppm-fuzz-cli-{}", std::process::id()));
@@ -89,39 +56,19 @@ fn scene(name: &str, text: &str) -> String {
 
 /// Run sppm for at most LIMIT: (exit code, None if stopped), stdout, stderr.
 fn run(args: &[String]) -> (Option<i32>, String, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_sppm"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // read both pipes on threads so that a chatty child never blocks on a full pipe
-    let mut so = child.stdout.take().unwrap();
-    let mut se = child.stderr.take().unwrap();
-    let t_out = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = so.read_to_string(&mut s);
-        s
-    });
-    let t_err = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = se.read_to_string(&mut s);
-        s
-    });
-    let start = Instant::now();
-    let code = loop {
-        if let Some(st) = child.try_wait().unwrap() {
-            break st.code();
-        }
-        if start.elapsed() > LIMIT {
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    };
-    (code, t_out.join().unwrap(), t_err.join().unwrap())
+    match common::run_limited(
+        Command::new(env!("CARGO_BIN_EXE_sppm"))
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR")),
+        LIMIT,
+    ) {
+        Some(o) => (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        ),
+        None => (None, String::new(), String::new()),
+    }
 }
 
 /// No panic; exit 0 only with finite results.

@@ -2,19 +2,17 @@
 //! lost or mixed (docs/reliability.md). Each test is the reproduction given in the issue,
 //! scaled down where it would be slow; resource tests assert the refusal before allocation.
 
+mod common;
+use common::{run_limited, sppm, wait_until};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 fn bin() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_sppm"));
     c.current_dir(env!("CARGO_MANIFEST_DIR"));
     c
-}
-
-fn sppm(args: &[&str]) -> Output {
-    bin().args(args).output().expect("sppm runs")
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -46,22 +44,6 @@ fn plate(out: &Path, sets: &[&str]) -> Output {
     sppm(&args)
 }
 
-/// Wait for a child at most `limit`; kill it and fail if it is still running then.
-fn wait_at_most(mut child: std::process::Child, limit: Duration, what: &str) -> Output {
-    let start = Instant::now();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            return child.wait_with_output().unwrap();
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{what}: still running after {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
 /// The coarse uniaxial tension block solved by relaxation, with extra overrides.
 fn relaxation_block(out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -86,16 +68,11 @@ fn relaxation_block(out: &Path, extra: &[&str]) -> Output {
 #[test]
 fn bench_refuses_a_particle_count_beyond_memory_before_allocating() {
     for n in ["100000000", "1000000000000"] {
-        let o = wait_at_most(
-            bin()
-                .args(["bench", "--particles", n])
-                .stdout(Stdio::piped())
-                .stderr(Stdio::piped())
-                .spawn()
-                .unwrap(),
+        let o = run_limited(
+            bin().args(["bench", "--particles", n]),
             Duration::from_secs(20),
-            "bench --particles",
-        );
+        )
+        .expect("bench --particles");
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
         let e = stderr(&o);
         assert!(
@@ -107,16 +84,8 @@ fn bench_refuses_a_particle_count_beyond_memory_before_allocating() {
 
 #[test]
 fn an_endless_scene_file_is_refused_without_reading_it_all() {
-    let o = wait_at_most(
-        bin()
-            .args(["check", "/dev/zero"])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap(),
-        Duration::from_secs(20),
-        "check /dev/zero",
-    );
+    let o = run_limited(bin().args(["check", "/dev/zero"]), Duration::from_secs(20))
+        .expect("check /dev/zero");
     assert_eq!(o.status.code(), Some(2));
     assert!(
         stderr(&o).contains("at most 1048576 bytes"),
@@ -236,24 +205,19 @@ fn an_unwritable_output_folder_is_refused_before_the_run() {
     std::fs::write(&file, "not a folder").unwrap();
     let out = file.join("out");
     // a run of 1e5 periods: it would never end, were the folder checked after it
-    let o = wait_at_most(
-        bin()
-            .args([
-                "run",
-                "lattices/elastic_plate.toml",
-                "--quiet",
-                "--out",
-                out.to_str().unwrap(),
-                "--set",
-                "loading.end_periods=1e5",
-            ])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap(),
+    let o = run_limited(
+        bin().args([
+            "run",
+            "lattices/elastic_plate.toml",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "loading.end_periods=1e5",
+        ]),
         Duration::from_secs(60),
-        "run into an unwritable folder",
-    );
+    )
+    .expect("run into an unwritable folder");
     assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
     assert!(stderr(&o).contains(out.to_str().unwrap()), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&base);
@@ -357,14 +321,9 @@ fn a_second_run_into_a_busy_folder_is_refused_naming_the_first() {
         .unwrap();
     // the lock record appears once the first run holds the folder
     let lock = out.join(".sppm.lock");
-    let start = Instant::now();
-    while std::fs::read_to_string(&lock)
-        .map(|t| t.is_empty())
-        .unwrap_or(true)
-    {
-        assert!(start.elapsed() < Duration::from_secs(30), "no lock taken");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_until(Duration::from_secs(30), "the first run's lock", || {
+        std::fs::read_to_string(&lock).is_ok_and(|t| !t.is_empty())
+    });
     let o = sppm(&args);
     let _ = first.kill();
     let _ = first.wait();

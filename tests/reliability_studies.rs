@@ -47,37 +47,21 @@ fn s(p: &Path) -> &str {
 /// Returns the exit code (`None`: killed or timed out), stderr and the time taken.
 fn sppm_bounded(args: &[&str], secs: u64) -> (Option<i32>, String, Duration) {
     let start = Instant::now();
-    let mut child = Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 4194304 && exec \"$@\"")
-        .arg("sh")
-        .arg(env!("CARGO_BIN_EXE_sppm"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let status = loop {
-        if let Some(st) = child.try_wait().unwrap() {
-            break Some(st);
-        }
-        if start.elapsed() > Duration::from_secs(secs) {
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    let mut err = String::new();
-    use std::io::Read;
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    (status.and_then(|s| s.code()), err, start.elapsed())
+    let out = common::run_limited(
+        Command::new("sh")
+            .arg("-c")
+            .arg("ulimit -v 4194304 && exec \"$@\"")
+            .arg("sh")
+            .arg(env!("CARGO_BIN_EXE_sppm"))
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR")),
+        Duration::from_secs(secs),
+    );
+    let code = out.as_ref().and_then(|o| o.status.code());
+    let err = out
+        .map(|o| String::from_utf8_lossy(&o.stderr).into_owned())
+        .unwrap_or_default();
+    (code, err, start.elapsed())
 }
 
 #[test]
@@ -457,11 +441,9 @@ fn a_second_study_into_a_busy_folder_is_refused() {
         .unwrap();
     // wait until the first has started its study (its CSV exists)
     let csv = out.join("objectivity.csv");
-    let start = Instant::now();
-    while !csv.exists() && start.elapsed() < Duration::from_secs(30) {
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    assert!(csv.exists(), "the first study did not start");
+    common::wait_until(Duration::from_secs(30), "the first study's CSV", || {
+        csv.exists()
+    });
     let arg_refs: Vec<&str> = args.iter().map(String::as_str).collect();
     let second = sppm(&arg_refs);
     let still_running = first.try_wait().unwrap().is_none();

@@ -28,25 +28,6 @@ pub fn is_run_file(name: &str) -> bool {
     RUN_FILES.contains(&name) || (name.starts_with("random_field_") && name.ends_with(".svg"))
 }
 
-/// A run's output folder, checked, created and locked before the run starts (so an
-/// unwritable folder costs no compute, and two runs never write into one folder at once).
-pub struct RunFolder {
-    pub dir: PathBuf,
-    _lock: fsio::FolderLock,
-}
-
-impl RunFolder {
-    /// Create `dir`, check that files can be written in it, and lock it.
-    pub fn open(dir: &Path) -> anyhow::Result<RunFolder> {
-        fsio::ensure_writable_folder(dir)?;
-        let lock = fsio::FolderLock::acquire(dir)?;
-        Ok(RunFolder {
-            dir: dir.to_path_buf(),
-            _lock: lock,
-        })
-    }
-}
-
 /// Write every output the scene asks for into `dir`; returns the files written.
 ///
 /// Each file is written under a temporary name and renamed into place ([`fsio`]), so no
@@ -107,14 +88,10 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
     Ok(files)
 }
 
-/// Write the run's summary.json into `dir` (atomically).
+/// Write the run's summary.json into `dir` (created if needed), atomically.
 pub fn write_summary(outcome: &Outcome, dir: &Path) -> anyhow::Result<()> {
-    let path = dir.join("summary.json");
-    fsio::write_atomic(
-        &path,
-        (serde_json::to_string_pretty(&outcome.summary)? + "\n").as_bytes(),
-    )?;
-    Ok(())
+    std::fs::create_dir_all(dir).map_err(|e| fsio::IoFailure::new("create the folder", dir, e))?;
+    fsio::write_json(&dir.join("summary.json"), &outcome.summary)
 }
 
 /// Remove the run files in `dir` (and temporary files of interrupted writes) that are not

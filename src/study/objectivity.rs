@@ -384,10 +384,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         rows: results.iter().map(|r| r.row.clone()).collect(),
         dir: dir.clone(),
     };
-    crate::fsio::write_atomic(
-        &dir.join("objectivity.json"),
-        (serde_json::to_string_pretty(&report)? + "\n").as_bytes(),
-    )?;
+    crate::fsio::write_json(&dir.join("objectivity.json"), &report)?;
     drop(lock);
     Ok(report)
 }

@@ -272,7 +272,8 @@ impl Study<'_> {
             }
             w.flush()?;
             Ok(())
-        })
+        })?;
+        Ok(())
     }
 
     /// Refuse a folder that holds study rows made with other inputs, or study rows without
@@ -298,10 +299,7 @@ impl Study<'_> {
             }
             Err(e) => return Err(IoFailure::new("read", &path, e).into()),
         }
-        fsio::write_atomic(
-            &path,
-            (serde_json::to_string_pretty(&self.inputs)? + "\n").as_bytes(),
-        )?;
+        fsio::write_json(&path, &self.inputs)?;
         Ok(())
     }
 
@@ -342,7 +340,7 @@ impl Study<'_> {
                     RunOutputs::All => {
                         crate::output::write_all(&outcome, &dir)?;
                     }
-                    RunOutputs::Summary => write_summary(&outcome, &dir)?,
+                    RunOutputs::Summary => crate::output::write_summary(&outcome, &dir)?,
                 }
                 let s = &outcome.summary;
                 row.particles = s.particles;
@@ -398,32 +396,30 @@ impl Study<'_> {
     }
 
     /// Read the scenes of the first, the last and the probe runs: bad input stops the study
-    /// here, before anything runs (and before the study folder is made). Returns the scene
-    /// of the first run (`None` without runs).
-    pub fn check(&self, runs: &Runs) -> anyhow::Result<Option<Scene>> {
+    /// here, before anything runs (and before the study folder is made).
+    pub fn check(&self, runs: &Runs) -> anyhow::Result<()> {
         if runs.count == 0 {
-            return Ok(None);
+            return Ok(());
         }
         let mut probes = vec![0, runs.count - 1];
         probes.extend(runs.probes.iter().copied());
         probes.sort_unstable();
         probes.dedup();
-        let mut first = None;
         for k in probes {
             anyhow::ensure!(k < runs.count, "study probe run {k} of {} runs", runs.count);
             let v = (runs.variant)(k);
             self.check_variant(&v)?;
-            let scene = self
-                .scene_of(&v)
+            self.scene_of(&v)
                 .with_context(|| format!("study variant {}", v.label))?;
-            first.get_or_insert(scene);
         }
-        Ok(first)
+        Ok(())
     }
 
     /// Run every variant that has no row yet, `jobs` at a time, appending each row as its
     /// run finishes; then return all variants' rows (in the order given) with their curves.
-    /// `lock` is the study folder's lock, held by the caller for the whole study.
+    /// `lock` is the study folder's lock, held by the caller for the whole study; the caller
+    /// has read the probe scenes ([`Study::check`]) and checked its count against the memory
+    /// budget before it took the lock (and so made the folder).
     pub fn run(&self, lock: &FolderLock, runs: &Runs) -> anyhow::Result<Vec<RunResult>> {
         anyhow::ensure!(
             lock.path() == self.dir.join(fsio::LOCK_FILE),
@@ -432,17 +428,6 @@ impl Study<'_> {
             lock.path().display()
         );
         let count = runs.count;
-        if let Some(first) = self.check(runs)? {
-            // the studies check their counts with their options named; this is the backstop
-            crate::limits::check_count(
-                "study runs",
-                count as f64,
-                self.bytes_per_run(&first),
-                "runs",
-            )?;
-        }
-        std::fs::create_dir_all(&self.dir)
-            .map_err(|e| IoFailure::new("create the study folder", &self.dir, e))?;
         self.check_inputs()?;
         let done: HashSet<String> = self.read_rows()?.into_iter().map(|r| r.label).collect();
         // one pass over the labels (made, checked and dropped one at a time): each once,
@@ -456,11 +441,8 @@ impl Study<'_> {
                 if !done.contains(&v.label) {
                     pending += 1;
                 }
-                if !seen.insert(v.label) {
-                    bail!(
-                        "study variant label `{}` appears twice",
-                        (runs.variant)(k).label
-                    );
+                if let Some(label) = seen.replace(v.label) {
+                    bail!("study variant label `{label}` appears twice");
                 }
             }
         }
@@ -477,12 +459,7 @@ impl Study<'_> {
         let mut writer = csv::WriterBuilder::new().from_writer(file);
         let append = |w: &mut csv::Writer<std::fs::File>, record: Vec<String>| {
             w.write_record(record)
-                .map_err(|e| match e.into_kind() {
-                    csv::ErrorKind::Io(io) => IoFailure::new("write", &path, io),
-                    other => {
-                        IoFailure::new("write", &path, std::io::Error::other(format!("{other:?}")))
-                    }
-                })
+                .map_err(|e| fsio::csv_failure(&path, e))
                 .and_then(|()| w.flush().map_err(|e| IoFailure::new("write", &path, e)))
         };
         if fresh {
@@ -624,17 +601,6 @@ pub fn no_inputs_record(dir: &Path, csv: &Path, rows: usize) -> String {
         csv.display(),
         dir.display()
     )
-}
-
-/// Write only a run's summary.json into `dir`.
-fn write_summary(outcome: &Outcome, dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| IoFailure::new("create the output folder", dir, e))?;
-    let path = dir.join("summary.json");
-    fsio::write_atomic(
-        &path,
-        (serde_json::to_string_pretty(&outcome.summary)? + "\n").as_bytes(),
-    )?;
-    Ok(())
 }
 
 /// (displacement_m, force_N) of a run's force_displacement.csv.

@@ -249,10 +249,7 @@ pub fn report(
             o.insert(k.clone(), v.clone());
         }
     }
-    crate::fsio::write_atomic(
-        &dir.join("size_effect.json"),
-        (serde_json::to_string_pretty(&json)? + "\n").as_bytes(),
-    )?;
+    crate::fsio::write_json(&dir.join("size_effect.json"), &json)?;
     crate::fsio::write_with(&dir.join("size_effect.svg"), |tmp: &Path| {
         super::plots::size_effect(title, &effect, tmp)
     })?;
