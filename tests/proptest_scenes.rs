@@ -94,10 +94,7 @@ fn exercise(text: &str, full: bool) {
         // one folder per call: the proptests run on parallel threads of one process
         static CALL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
         let call = CALL.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!(
-            "sppm-proptest-{}-{call}",
-            std::process::id()
-        ));
+        let dir = std::env::temp_dir().join(format!("sppm-proptest-{}-{call}", std::process::id()));
         sppm::output::write_all(&out, &dir).unwrap();
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -44,6 +44,19 @@ fn plate(out: &Path, sets: &[&str]) -> Output {
     sppm(&args)
 }
 
+/// Arguments of a run of the plate over 1e5 periods into `out`: one that would take hours.
+fn endless_run(out: &Path) -> [&str; 7] {
+    [
+        "run",
+        "lattices/elastic_plate.toml",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "loading.end_periods=1e5",
+    ]
+}
+
 /// The coarse uniaxial tension block solved by relaxation, with extra overrides.
 fn relaxation_block(out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -205,19 +218,8 @@ fn an_unwritable_output_folder_is_refused_before_the_run() {
     std::fs::write(&file, "not a folder").unwrap();
     let out = file.join("out");
     // a run of 1e5 periods: it would never end, were the folder checked after it
-    let o = run_limited(
-        bin().args([
-            "run",
-            "lattices/elastic_plate.toml",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-            "--set",
-            "loading.end_periods=1e5",
-        ]),
-        Duration::from_secs(60),
-    )
-    .expect("run into an unwritable folder");
+    let o = run_limited(bin().args(endless_run(&out)), Duration::from_secs(60))
+        .expect("run into an unwritable folder");
     assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
     assert!(stderr(&o).contains(out.to_str().unwrap()), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&base);
@@ -304,15 +306,7 @@ fn a_write_that_fails_leaves_no_truncated_file_and_no_summary() {
 #[test]
 fn a_second_run_into_a_busy_folder_is_refused_naming_the_first() {
     let out = tmp("lock");
-    let args = [
-        "run",
-        "lattices/elastic_plate.toml",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--set",
-        "loading.end_periods=1e5",
-    ];
+    let args = endless_run(&out);
     let mut first = bin()
         .args(args)
         .stdout(Stdio::null())
