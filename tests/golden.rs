@@ -1,0 +1,170 @@
+//! Golden results: every shipped scene gives, bit for bit, the peak force, dissipated energy,
+//! step count and particle count recorded before the pipeline was made generic over
+//! discretisation and dimension (issue 12). Recorded with the binary of commit f185737
+//! (`sppm run lattices/<scene>.toml --quiet`, 2 threads). A change that moves any of these
+//! numbers changes the physics or the arithmetic of a 2D run, and must say so.
+//!
+//! The uniaxial tension block also runs on one thread: the thread count must not change
+//! results.
+
+mod common;
+
+struct Golden {
+    scene: &'static str,
+    peak_force_n: f64,
+    dissipated_energy_j: f64,
+    steps: u64,
+    particles: u64,
+}
+
+const GOLDEN: &[Golden] = &[
+    Golden {
+        scene: "dogbone_B",
+        peak_force_n: 14520.232370173937,
+        dissipated_energy_j: 0.5127207599523118,
+        steps: 141915,
+        particles: 908,
+    },
+    Golden {
+        scene: "dogbone_D",
+        peak_force_n: 56144.4683650555,
+        dissipated_energy_j: 2.118930497626183,
+        steps: 289614,
+        particles: 3576,
+    },
+    Golden {
+        scene: "dogbone_montecarlo",
+        peak_force_n: 49205.012399972955,
+        dissipated_energy_j: 0.8149639805052947,
+        steps: 5870,
+        particles: 3576,
+    },
+    Golden {
+        scene: "elastic_plate",
+        peak_force_n: 15311.822416652245,
+        dissipated_energy_j: -9.661997764365271e-14,
+        steps: 42620,
+        particles: 5858,
+    },
+    Golden {
+        scene: "split_cylinder",
+        peak_force_n: 241421.2638407034,
+        dissipated_energy_j: 7.1835470477530645,
+        steps: 42090,
+        particles: 823,
+    },
+    Golden {
+        scene: "uniaxial_compression",
+        peak_force_n: 503506.53319232847,
+        dissipated_energy_j: 66.2452203572087,
+        steps: 71923,
+        particles: 543,
+    },
+    Golden {
+        scene: "uniaxial_tension",
+        peak_force_n: 56322.7480348242,
+        dissipated_energy_j: 1.7863414068707248,
+        steps: 71923,
+        particles: 543,
+    },
+];
+
+fn check(scene: &str, threads: &str) {
+    let g = GOLDEN
+        .iter()
+        .find(|g| g.scene == scene)
+        .expect("a golden scene");
+    let dir = std::env::temp_dir().join(format!(
+        "sppm-golden-{scene}-{threads}-{}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    let path = format!("lattices/{scene}.toml");
+    let out = common::sppm(&[
+        "run",
+        &path,
+        "--quiet",
+        "--threads",
+        threads,
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{scene}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let s: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let peak = s["peak_force_N"].as_f64().unwrap();
+    let energy = s["dissipated_energy_J"].as_f64().unwrap();
+    let steps = s["steps"].as_u64().unwrap();
+    let particles = s["particles"].as_u64().unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(particles, g.particles, "{scene}: particles");
+    assert_eq!(steps, g.steps, "{scene}: steps");
+    assert_eq!(
+        peak.to_bits(),
+        g.peak_force_n.to_bits(),
+        "{scene}: peak force {peak:e} N, golden {:e} N",
+        g.peak_force_n
+    );
+    assert_eq!(
+        energy.to_bits(),
+        g.dissipated_energy_j.to_bits(),
+        "{scene}: dissipated energy {energy:e} J, golden {:e} J",
+        g.dissipated_energy_j
+    );
+}
+
+#[test]
+fn every_shipped_scene_has_a_golden_record() {
+    let mut shipped: Vec<String> =
+        std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/lattices"))
+            .unwrap()
+            .filter_map(|e| e.ok()?.path().file_stem()?.to_str().map(String::from))
+            .collect();
+    shipped.sort();
+    let golden: Vec<&str> = GOLDEN.iter().map(|g| g.scene).collect();
+    assert_eq!(shipped, golden);
+}
+
+#[test]
+fn golden_dogbone_b() {
+    check("dogbone_B", "2");
+}
+
+#[test]
+fn golden_dogbone_d() {
+    check("dogbone_D", "2");
+}
+
+#[test]
+fn golden_dogbone_montecarlo() {
+    check("dogbone_montecarlo", "2");
+}
+
+#[test]
+fn golden_elastic_plate() {
+    check("elastic_plate", "2");
+}
+
+#[test]
+fn golden_split_cylinder() {
+    check("split_cylinder", "2");
+}
+
+#[test]
+fn golden_uniaxial_compression() {
+    check("uniaxial_compression", "2");
+}
+
+#[test]
+fn golden_uniaxial_tension() {
+    check("uniaxial_tension", "2");
+}
+
+#[test]
+fn golden_uniaxial_tension_one_thread() {
+    check("uniaxial_tension", "1");
+}
