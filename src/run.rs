@@ -5,8 +5,10 @@
 use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
 use crate::material;
 use crate::material::properties::{self, FieldReport, SampledField};
+use crate::model::force_state::{dilatation_term, force_state};
 use crate::model::micro_modulus::{self, MicroModuli};
 use crate::model::stress::StressSum;
+use crate::model::stretch::total_stretch;
 use crate::scene::{Scene, SceneError, SolverMethod};
 use crate::solver::concrete::{self, Concrete, ParticleDamage};
 use crate::solver::loading::Prescribed;
@@ -503,14 +505,18 @@ pub fn particle_stress(
         .map(|i| {
             let mut theta = 0.0;
             for (_, j, il) in mech.bonds(i) {
-                theta += (x[j] - x[i]).norm() * il - 1.0;
+                theta += total_stretch((x[j] - x[i]).norm(), il);
             }
             let mut acc = StressSum::default();
             for (_, j, il) in mech.bonds(i) {
                 let d = x[j] - x[i];
                 let len = d.norm();
-                let s = len * il - 1.0;
-                acc.add(&(d / len), 1.0 / il, mech.a[i] * s + mech.b[i] * theta);
+                let s = total_stretch(len, il);
+                acc.add(
+                    &(d / len),
+                    1.0 / il,
+                    force_state(mech.a[i], s, dilatation_term(mech.b[i], theta)),
+                );
             }
             acc.finish(volume[i])
         })

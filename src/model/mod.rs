@@ -1,6 +1,7 @@
 //! The SPLM/SPPM constitutive model: micro-moduli, stretch, force state, stress, strain,
 //! damage and plasticity.
 pub mod damage;
+pub mod force_state;
 pub mod micro_modulus;
 pub mod plasticity;
 pub mod strain;

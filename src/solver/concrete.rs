@@ -38,6 +38,10 @@ use super::mechanics::Mechanics;
 use super::KernelSet;
 use crate::discretise::{Particles, NONE};
 use crate::model::damage::{self, ConcreteLaw, LocalProperties};
+use crate::model::force_state::{
+    bond_energy, damaged_axial, damaged_bond_force, damaged_force_state, dilatation_term,
+    force_state,
+};
 use crate::model::micro_modulus::elasticity_matrix;
 use crate::model::plasticity;
 use crate::model::strain::{self, StrainFit};
@@ -223,7 +227,7 @@ fn slots<const K: usize, const FULL: bool>(
             theta += s.sd * s.se;
         }
     }
-    (out, m.b[i] * theta)
+    (out, dilatation_term(m.b[i], theta))
 }
 
 /// Pass 1 for particle i: bθ_i, and the trial damage and plastic stretch state.
@@ -265,7 +269,7 @@ fn update_state<const K: usize, const FULL: bool>(
                 same &= dse[k] == st[k];
                 SlotCache {
                     e: s.e,
-                    d_a_se: s.d * ((m.a[i] + m.a[j]) * s.se),
+                    d_a_se: damaged_axial(s.d, m.a[i], m.a[j], s.se),
                     sd: s.sd,
                     d: s.d,
                 }
@@ -273,7 +277,7 @@ fn update_state<const K: usize, const FULL: bool>(
             None => SlotCache::default(),
         };
     }
-    let b_theta = m.b[i] * theta;
+    let b_theta = dilatation_term(m.b[i], theta);
     let local_law;
     let law = match &c.local {
         Some(l) => {
@@ -340,10 +344,10 @@ fn update_state<const K: usize, const FULL: bool>(
                 plasticity::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
             if ratio >= 1.0 {
                 let mut fs = [0.0; K];
-                let bt = m.b[i] * theta_e;
+                let bt = dilatation_term(m.b[i], theta_e);
                 for k in 0..K {
                     if used[k] {
-                        fs[k] = m.a[i] * se[k] + bt;
+                        fs[k] = force_state(m.a[i], se[k], bt);
                     }
                 }
                 plasticity::flow(&fs, &used, ratio, law.fy / law.e, sps_trial);
@@ -400,7 +404,7 @@ fn particle_force<const K: usize, const DAMP: bool>(
             continue;
         }
         let j = j as usize;
-        let mut fb = 0.5 * (s.d_a_se + s.sd * (b_theta[i] + b_theta[j]));
+        let mut fb = damaged_bond_force(s.d_a_se, s.sd, b_theta[i], b_theta[j]);
         if DAMP {
             let cb = s.d * 0.5 * (m.c_in[i] + m.c_in[j]);
             let rate = (v[j] - v[i]).dot(&s.e);
@@ -481,7 +485,8 @@ pub fn internal_energy<const K: usize>(
             let mut u = 0.0;
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
-                    u += s.se * (s.d * m.a[i] * s.se + s.sd * bt) / m.inv_l0[i][k];
+                    let fs = damaged_force_state(s.d, s.sd, m.a[i], s.se, bt);
+                    u += bond_energy(s.se, fs, m.inv_l0[i][k]);
                 }
             }
             0.25 * u
@@ -503,7 +508,11 @@ pub fn particle_stress<const K: usize>(
             let mut acc = StressSum::default();
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
-                    acc.add(&s.e, 1.0 / m.inv_l0[i][k], s.d * m.a[i] * s.se + s.sd * bt);
+                    acc.add(
+                        &s.e,
+                        1.0 / m.inv_l0[i][k],
+                        damaged_force_state(s.d, s.sd, m.a[i], s.se, bt),
+                    );
                 }
             }
             acc.finish(volume[i])

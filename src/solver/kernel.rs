@@ -20,6 +20,7 @@
 //! step's positions drives this step.
 
 use super::mechanics::Mechanics;
+use crate::model::force_state::{bond_force, dilatation_term};
 use crate::model::stretch::total_stretch;
 use nalgebra::SVector;
 use rayon::prelude::*;
@@ -114,7 +115,7 @@ fn dilatation_one<const D: usize, const K: usize>(
         let xj = unsafe { *x.get_unchecked(j as usize) };
         s += total_stretch((xj - xi).norm(), il[k]);
     }
-    m.b[i] * s
+    dilatation_term(m.b[i], s)
 }
 
 /// [`dilatation_one`] that also stores each slot's stretch and inverse length (0 where the
@@ -148,7 +149,7 @@ fn dilatation_one_cached<const D: usize, const K: usize>(
         cache[at + LANES] = 1.0 / len;
         s += st;
     }
-    m.b[i] * s
+    dilatation_term(m.b[i], s)
 }
 
 /// Whether the AVX block kernels can run on this CPU.
@@ -278,7 +279,7 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
         let len = d.norm();
         let e = d * (1.0 / len);
         let s = total_stretch(len, il[k]);
-        let mut fb = 0.5 * ((ai + aj) * s + bti + btj);
+        let mut fb = bond_force(ai, aj, s, bti, btj);
         if DAMP {
             let (vj, cj) = unsafe { (*v.get_unchecked(j), *m.c_in.get_unchecked(j)) };
             let c = 0.5 * (m.c_in[i] + cj);

@@ -4,6 +4,7 @@
 //! Used for the fundamental period and for the patch test at round-off accuracy.
 
 use super::mechanics::Mechanics;
+use crate::model::force_state::{bond_force, dilatation_term, force_state};
 use nalgebra::SVector;
 use rayon::prelude::*;
 
@@ -56,10 +57,13 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
                 let mut acc = SVector::<f64, D>::zeros();
                 for (_, j, il) in mech.bonds(i) {
                     let (s, n) = this.stretch(u, i, j, il);
-                    let fb = 0.5
-                        * ((mech.a[i] + mech.a[j]) * s
-                            + mech.b[i] * theta[i]
-                            + mech.b[j] * theta[j]);
+                    let fb = bond_force(
+                        mech.a[i],
+                        mech.a[j],
+                        s,
+                        dilatation_term(mech.b[i], theta[i]),
+                        dilatation_term(mech.b[j], theta[j]),
+                    );
                     acc += n * fb;
                 }
                 *fi = acc;
@@ -81,7 +85,11 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
                 (
                     n,
                     1.0 / il,
-                    self.mech.a[i] * s + self.mech.b[i] * self.theta[i],
+                    force_state(
+                        self.mech.a[i],
+                        s,
+                        dilatation_term(self.mech.b[i], self.theta[i]),
+                    ),
                 )
             })
             .collect()

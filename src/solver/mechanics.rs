@@ -2,6 +2,7 @@
 //! neighbour slots, 1/L0 per slot, micro-moduli, masses and damper coefficients.
 
 use crate::discretise::{Particles, NONE};
+use crate::model::force_state::axial_stiffness;
 use nalgebra::SVector;
 
 /// The assembled SPLM model of one run.
@@ -110,7 +111,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             let (ai, bi) = (self.a[i], self.b[i].abs());
             for (_, j, il) in self.bonds(i) {
                 // a-term: block to u_j and its share of the diagonal block
-                r += (ai + self.a[j]) * il;
+                r += 2.0 * axial_stiffness(ai, self.a[j]) * il;
                 // b_j θ_j term: blocks to the neighbours m of j and to u_j
                 let bj = self.b[j].abs();
                 r += 0.5 * bj * (sum_inv_l[j] + sum_n_over_l[j]);

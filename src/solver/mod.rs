@@ -445,12 +445,12 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 let mut sum_s2_l = 0.0;
                 let mut sum_s_l = 0.0;
                 for (_, j, il) in m.bonds(i) {
-                    let s = ((x[j] - x[i]).norm()) * il - 1.0;
+                    let s = crate::model::stretch::total_stretch((x[j] - x[i]).norm(), il);
                     sum_s += s;
                     sum_s2_l += s * s / il;
                     sum_s_l += s / il;
                 }
-                0.25 * (m.a[i] * sum_s2_l + m.b[i] * sum_s * sum_s_l)
+                crate::model::force_state::particle_energy(m.a[i], m.b[i], sum_s, sum_s2_l, sum_s_l)
             })
             .sum()
     }
