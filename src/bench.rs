@@ -60,10 +60,12 @@ pub fn bench(
         offset: Vector2::zeros(),
         thickness: 0.1,
     };
-    let p = lat.fill(&shape);
+    let mut p = lat.fill(&shape);
     let n = p.len();
     let mm = micro_modulus::hexagonal(30e9, 0.2, l0, 0.1, Plane::Stress);
-    let mut mech = Mechanics::new(&p, vec![mm.a; n], vec![mm.b; n], &vec![2400.0; n]);
+    p.a = vec![mm.a; n];
+    p.b = vec![mm.b; n];
+    let mut mech = Mechanics::new(&p, &vec![2400.0; n]);
     let omega = crate::material::particle_frequency(30e9, 0.2, 2400.0, l0);
     for i in 0..n {
         mech.c_in[i] = 2.0 * mech.mass[i] * 0.2 * omega;
@@ -77,7 +79,7 @@ pub fn bench(
         *x = x0 * (1.0 + strain);
     }
     let mut model = concrete.then(|| {
-        let cod_c = crate::material::concrete::critical_crack_opening(81.4, 2.6168e6, 0.1, 0.25);
+        let cod_c = crate::scene::concrete::critical_crack_opening(81.4, 2.6168e6, 0.1, 0.25);
         let law = crate::model::damage::ConcreteLaw {
             e: 30e9,
             nu: 0.2,
@@ -98,9 +100,12 @@ pub fn bench(
             tensile_damage: true,
             compressive_damage: kernel == KernelSet::Full,
             plasticity: kernel == KernelSet::Full,
-            crack_band: 2.8 * l0,
+            crack_band: 2.8,
         };
-        crate::solver::concrete::Concrete::new(law, &p)
+        crate::solver::concrete::Concrete::<6>::new(
+            crate::model::two_spring::TwoSpring::new(law, None),
+            &p,
+        )
     });
     let chosen = model.as_ref().map_or(KernelSet::Elastic, |c| c.kernel());
     anyhow::ensure!(

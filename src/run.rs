@@ -9,8 +9,9 @@ use crate::model::force_state::{dilatation_term, force_state};
 use crate::model::micro_modulus::{self, MicroModuli};
 use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
+use crate::model::two_spring::TwoSpring;
 use crate::scene::{Scene, SceneError, SolverMethod};
-use crate::solver::concrete::{self, Concrete, ParticleDamage};
+use crate::solver::concrete::{Concrete, ParticleDamage};
 use crate::solver::loading::Prescribed;
 use crate::solver::mechanics::Mechanics;
 use crate::solver::time_step::{stable_step, StableStep};
@@ -199,10 +200,22 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
 
     // Micro-moduli, with the surface correction of particles that miss bonds.
     stage("micro-moduli and the surface correction");
+    // Bulk constants (4.5), (4.6) of each particle's own spacing; reported at the nominal one.
     let bulk = micro_modulus::hexagonal(m.youngs_modulus(), m.nu, d.spacing, m.thickness, m.plane);
     let dmat = micro_modulus::elasticity_matrix(m.youngs_modulus(), m.nu, m.plane);
-    let mut a = vec![bulk.a; n];
-    let mut b = vec![bulk.b; n];
+    let own: Vec<MicroModuli> = (0..n)
+        .map(|i| {
+            micro_modulus::hexagonal(
+                m.youngs_modulus(),
+                m.nu,
+                particles.length[i],
+                m.thickness,
+                m.plane,
+            )
+        })
+        .collect();
+    let mut a: Vec<f64> = own.iter().map(|mm| mm.a).collect();
+    let mut b: Vec<f64> = own.iter().map(|mm| mm.b).collect();
     let mut surface = SurfaceCorrection {
         enabled: d.surface_correction,
         boundary_particles: 0,
@@ -254,8 +267,11 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
             b[i] *= f[i];
         }
     }
+    let mut particles = particles;
+    particles.a = a;
+    particles.b = b;
     let rho = vec![m.rho; n];
-    let mech = Mechanics::new(&particles, a, b, &rho);
+    let mech = Mechanics::new(&particles, &rho);
     Ok(Model {
         scene: scene.clone(),
         particles,
@@ -302,15 +318,20 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
 pub fn prepare_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Prepared, RunError> {
     let mut model = prepare_model_with(scene, stage)?;
     stage("fundamental period T1 (Lanczos)");
-    let d = &scene.discretisation;
     let m = &scene.material;
     let n = model.particles.len();
     let fundamental = modal::fundamental(&model.mech, &model.particles.x0, &model.constrained)
         .map_err(|e| modal_failure(&model, e))?;
-    let omega_i = material::particle_frequency(m.youngs_modulus(), m.nu, m.rho, d.spacing);
     let omega_struct = 2.0 * std::f64::consts::PI / fundamental.period;
     let mech = &mut model.mech;
     for i in 0..n {
+        // ω_i from the particle's own length scale (section 4.3)
+        let omega_i = material::particle_frequency(
+            m.youngs_modulus(),
+            m.nu,
+            m.rho,
+            model.particles.length[i],
+        );
         mech.c_in[i] = 2.0 * mech.mass[i] * scene.damping.internal * omega_i;
         mech.c_ex[i] = 2.0 * mech.mass[i] * scene.damping.external * omega_struct;
     }
@@ -454,7 +475,7 @@ pub struct Summary {
     /// The concrete law used (every value resolved).
     pub concrete: Option<crate::model::damage::ConcreteLaw>,
     /// Material values and where each came from (scene, preset or correlation).
-    pub material_values: Vec<crate::material::concrete::Derived>,
+    pub material_values: Vec<crate::scene::concrete::Derived>,
     pub force_lag: crate::scene::ForceLag,
     /// The step kernel chosen for the scene's features: elastic, tension or full.
     pub kernel: crate::solver::KernelSet,
@@ -552,9 +573,9 @@ pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
         std::mem::take(&mut p.model.prescribed),
         integration,
     );
-    if let Some(law) = p.model.scene.concrete_law() {
-        let mut c = Concrete::new(law, &p.model.particles);
-        c.local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
+    if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
+        let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
+        let c: Concrete<6> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
         sim.inelastic = Some(Box::new(c));
     }
     sim
@@ -619,8 +640,8 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
         .collect();
     let (stress, damage) = match &sim.inelastic {
         Some(model) => (
-            concrete::particle_stress(&sim.mech, model.concrete(), &x, &p.model.particles.volume),
-            Some(model.concrete().committed.clone()),
+            model.particle_stress(&sim.mech, &x, &p.model.particles.volume),
+            Some(model.damage()),
         ),
         None => (
             particle_stress(&sim.mech, &p.model.particles.volume, &x),
@@ -849,7 +870,7 @@ fn summarise(p: &Prepared, run: &Finished, damage: Option<&[ParticleDamage]>) ->
         cracked_particles: damage.map(|d| d.iter().filter(|p| p.wt >= 0.99).count()),
         crushed_particles: damage.map(|d| d.iter().filter(|p| p.wc >= 0.99).count()),
         yielded_particles: damage.map(|d| d.iter().filter(|p| p.yielded).count()),
-        concrete: p.model.scene.concrete_law(),
+        concrete: crate::model::damage::ConcreteLaw::from_scene(&p.model.scene),
         material_values: p.model.scene.derived.clone(),
         force_lag: p.model.scene.solver.force_lag,
         kernel,

@@ -67,7 +67,7 @@ fn fully_damaged_particle_transmits_no_force() {
         .iter()
         .map(|x| x + Vector2::new(-2e-5 * x.x + 1e-6 * (37.0 * x.y).sin(), 1e-4 * x.y))
         .collect();
-    let model = sim.inelastic.as_mut().unwrap().concrete_mut();
+    let model = sim.inelastic.as_mut().unwrap().concrete_mut().unwrap();
     for (i, d) in model.committed.iter_mut().enumerate() {
         d.wt = (i % 7) as f64 / 9.0;
         d.wc = (i % 5) as f64 / 11.0;
@@ -101,7 +101,7 @@ fn fully_damaged_particle_transmits_no_force() {
 fn uniaxial_tension_reaches_ft_and_dissipates_gf() {
     for spacing in [0.01, 0.005] {
         let scene = tension_block(0.1, spacing, &[]);
-        let law = scene.concrete_law().unwrap();
+        let law = sppm::model::damage::ConcreteLaw::from_scene(&scene).unwrap();
         let area = 0.15 * 0.15;
         let mut p = prepare(&scene).unwrap();
         let steps = p.steps;
@@ -120,7 +120,7 @@ fn uniaxial_tension_reaches_ft_and_dissipates_gf() {
                 );
                 dissipated_max = dissipated_max.max(d);
                 records.push(r);
-                let c = sim.inelastic.as_ref().unwrap().concrete();
+                let c = sim.inelastic.as_ref().unwrap().concrete().unwrap();
                 for (i, s) in c.committed.iter().enumerate() {
                     assert!(s.wt >= last[i].0 && s.wc >= last[i].1, "damage decreased");
                     assert!((0.0..=1.0).contains(&s.wt) && (0.0..=1.0).contains(&s.wc));
@@ -175,7 +175,7 @@ fn plastic_block_carries_the_hardening_yield_stress() {
             "loading.end_periods=40",
         ],
     );
-    let law = scene.concrete_law().unwrap();
+    let law = sppm::model::damage::ConcreteLaw::from_scene(&scene).unwrap();
     let o = run(&scene, &RunOptions::default()).unwrap();
     let sigma = -o.records.last().unwrap().force_n / (0.15 * 0.15);
     // least-squares gradient of u over the middle half of the block
@@ -246,12 +246,17 @@ fn tension_kernel_matches_the_full_kernel_bit_for_bit() {
     for force_full in [false, true] {
         let mut p = prepare(&scene).unwrap();
         let mut sim = build_simulation(&mut p);
-        sim.inelastic.as_mut().unwrap().concrete_mut().force_full = force_full;
+        sim.inelastic
+            .as_mut()
+            .unwrap()
+            .concrete_mut()
+            .unwrap()
+            .force_full = force_full;
         let probe = &p.probe.as_ref().unwrap().1;
         let forces: Vec<f64> = (0..p.steps)
             .filter_map(|_| sim.advance(Some(probe)).map(|r| r.force_n))
             .collect();
-        let c = sim.inelastic.as_ref().unwrap().concrete();
+        let c = sim.inelastic.as_ref().unwrap().concrete().unwrap();
         runs.push((
             sim.kernel(),
             forces,

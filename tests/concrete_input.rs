@@ -107,7 +107,7 @@ fn a_scene_value_overrides_the_correlation_and_says_so() {
         None,
         "G_f0 is not needed when G_f is given"
     );
-    let law = s.concrete_law().unwrap();
+    let law = sppm::model::damage::ConcreteLaw::from_scene(&s).unwrap();
     close("COD_c", law.cod_c, 2.0 * 100.0 / (3.0e6 * 0.35), 1e-12);
 }
 

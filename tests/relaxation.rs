@@ -107,7 +107,7 @@ fn relaxed_tension_block_reaches_ft() {
         0.01,
         &["solver.method=relaxation", "solver.max_residual=0.01"],
     );
-    let law = scene.concrete_law().unwrap();
+    let law = sppm::model::damage::ConcreteLaw::from_scene(&scene).unwrap();
     let area = 0.15 * 0.15;
     let out = run(&scene, 2);
     let sm = &out.summary;

@@ -103,14 +103,14 @@ impl HexLattice {
                 }
             }
         }
-        let mut particles = Particles {
+        let mut particles = Particles::new(
             x0,
-            volume: vec![self.cell_area() * self.thickness; n],
+            vec![self.cell_area() * self.thickness; n],
             neighbours,
             reverse,
             l0,
-            spacing: self.spacing,
-        };
+            self.spacing,
+        );
         drop_isolated(&mut particles);
         particles
     }
@@ -143,6 +143,9 @@ fn drop_isolated<const D: usize, const K: usize>(p: &mut Particles<D, K>) {
     retain(&mut p.reverse, &keep);
     retain(&mut p.l0, &keep);
     retain(&mut p.neighbours, &keep);
+    for v in [&mut p.horizon, &mut p.length, &mut p.a, &mut p.b, &mut p.c] {
+        retain(v, &keep);
+    }
     for slots in p.neighbours.iter_mut() {
         for j in slots.iter_mut() {
             if *j != NONE {

@@ -1,8 +1,13 @@
-//! Discretisations: particles with reference positions, volumes, fixed neighbour slots
-//! (with the reverse-slot index) and named groups (MODEL.md §1).
+//! Discretisations fill a body (MODEL.md §1): particles with reference positions, volumes,
+//! a horizon and a length scale each, their micro-moduli, and bonds with their own reference
+//! length; and named groups of particles.
 //!
-//! One container serves every dimension `D` and slot count `K` (6 for the 2D hexagonal
-//! lattice, 18 for 3D FCC and SPPM): an empty slot holds [`NONE`].
+//! Bonds come in two layouts. The fixed-slot layout of [`Particles`] is the fast path of the
+//! lattices (6 slots for the 2D hexagonal lattice, 18 for 3D FCC; an empty slot holds
+//! [`NONE`]); the compressed-row layout of `csr` serves a varying number of neighbours per
+//! particle (random particles). One container serves every dimension `D` and slot count `K`.
+//! Everything downstream (micro-moduli, dampers, time step, crack band) reads a particle's
+//! own values from the body, never the scene's nominal spacing.
 
 pub mod groups;
 pub mod hex;
@@ -25,11 +30,70 @@ pub struct Particles<const D: usize, const K: usize> {
     pub reverse: Vec<[u8; K]>,
     /// Reference bond length per slot (m); 0 where empty.
     pub l0: Vec<[f64; K]>,
-    /// Nearest-neighbour spacing L0 of the lattice (m).
+    /// Horizon r_i of each particle (m): the reach of its bonds (MODEL.md §1; L0 for the
+    /// hexagonal lattice, √2·L0 for FCC, the distance to the k-th nearest particle for SPPM).
+    pub horizon: Vec<f64>,
+    /// Each particle's own length scale L0,i (m), its nearest-neighbour spacing: the particle
+    /// frequency ω_i (section 4.3, (3.55)) and the crack band (4.13) use it.
+    pub length: Vec<f64>,
+    /// Micro-modulus a_i of each particle (N; MODEL.md §3), filled for the discretisation
+    /// by `run::prepare` (0 until then).
+    pub a: Vec<f64>,
+    /// Micro-modulus b_i (N).
+    pub b: Vec<f64>,
+    /// Micro-modulus c_i of second-neighbour bonds (N; FCC; 0 in 2D).
+    pub c: Vec<f64>,
+    /// Nominal spacing of the discretisation (m): the row pitch by which groups select edge
+    /// rows. Per-particle quantities use [`Self::length`].
     pub spacing: f64,
 }
 
 impl<const D: usize, const K: usize> Particles<D, K> {
+    /// A body of particles at `x0` with volumes, slots and per-slot reference lengths; each
+    /// particle's horizon is its longest bond and its length scale its shortest, the
+    /// micro-moduli are 0 until filled.
+    pub fn new(
+        x0: Vec<SVector<f64, D>>,
+        volume: Vec<f64>,
+        neighbours: Vec<[u32; K]>,
+        reverse: Vec<[u8; K]>,
+        l0: Vec<[f64; K]>,
+        spacing: f64,
+    ) -> Self {
+        let n = x0.len();
+        let mut p = Particles {
+            x0,
+            volume,
+            neighbours,
+            reverse,
+            l0,
+            horizon: vec![0.0; n],
+            length: vec![0.0; n],
+            a: vec![0.0; n],
+            b: vec![0.0; n],
+            c: vec![0.0; n],
+            spacing,
+        };
+        p.measure_bonds();
+        p
+    }
+
+    /// Set each particle's horizon (its longest bond) and length scale (its shortest bond;
+    /// the nominal spacing for a particle without bonds).
+    pub fn measure_bonds(&mut self) {
+        for i in 0..self.len() {
+            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+            for k in 0..K {
+                if self.neighbours[i][k] != NONE {
+                    lo = lo.min(self.l0[i][k]);
+                    hi = hi.max(self.l0[i][k]);
+                }
+            }
+            self.horizon[i] = if hi > 0.0 { hi } else { self.spacing };
+            self.length[i] = if lo.is_finite() { lo } else { self.spacing };
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.x0.len()
     }
@@ -84,11 +148,12 @@ impl<const D: usize, const K: usize> Particles<D, K> {
 /// (discretisation, model and solver state), used to refuse scenes too large for the machine
 /// before anything is allocated.
 pub const fn bytes_per_particle(d: usize, k: usize) -> usize {
-    // x0, x, x_next, v, v_next, force, force_prev: 7·D f64; volume, mass, inv_mass, a, b,
-    // c_in, c_ex, b·theta, damping energy: 9 f64; neighbours (u32), reverse (u8),
+    // x0, x, x_next, v, v_next, force, force_prev: 7·D f64; volume, horizon, length, the
+    // body's a, b, c, mass, inv_mass, the kernel's a, b, c_in, c_ex, b·theta, damping
+    // energy: 14 f64; neighbours (u32), reverse (u8),
     // l0 and 1/l0 (f64) and the kernel's cached stretch and 1/length (f64) per slot; group
     // bookkeeping and outputs: ~64 bytes.
-    7 * d * 8 + 9 * 8 + k * (4 + 1 + 32) + 64
+    7 * d * 8 + 14 * 8 + k * (4 + 1 + 32) + 64
 }
 
 /// Slots per particle of the standard lattices: 6 for the 2D hexagonal lattice, 18 for 3D.

@@ -1,5 +1,4 @@
 //! Elastic constants and the values derived from them for the dampers (MODEL.md §5).
-pub mod concrete;
 pub mod properties;
 pub mod random_field;
 

@@ -342,7 +342,7 @@ pub fn local_properties(
 /// (f't,i ≥ f'c,i: no concrete, and the two-spring law's criteria would cross), naming the
 /// field whose spread did it.
 pub fn check_strengths(scene: &Scene, fields: &[SampledField]) -> Result<(), SceneError> {
-    let Some(law) = scene.concrete_law() else {
+    let Some(law) = crate::model::damage::ConcreteLaw::from_scene(scene) else {
         return Ok(());
     };
     let ft = values_of(fields, FieldProperty::Ft);

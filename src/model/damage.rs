@@ -2,7 +2,7 @@
 //! tensile initiation and bilinear softening (§8, (4.12)–(4.14)), compressive damage
 //! (§9, (4.16), (4.17)).
 
-use crate::scene::{CrackOpening, Initiation, Plane};
+use crate::scene::{CrackOpening, Initiation, Plane, Scene};
 
 /// The resolved concrete law of a run (every value in SI; see `Scene::concrete_law`).
 #[derive(Clone, Copy, Debug, serde::Serialize)]
@@ -28,8 +28,8 @@ pub struct ConcreteLaw {
     pub tensile_damage: bool,
     pub compressive_damage: bool,
     pub plasticity: bool,
-    /// The length that turns the largest principal strain into a crack opening,
-    /// COD_eq = crack_band·ε_I: 2·L0 (4.13).
+    /// The crack band in units of a particle's own length scale L0,i (the body's
+    /// `length`): COD_eq = crack_band·L0,i·ε_I ((4.13) writes 2; see `concrete.crack_band`).
     pub crack_band: f64,
 }
 
@@ -48,11 +48,40 @@ pub struct LocalProperties {
 }
 
 impl ConcreteLaw {
+    /// The concrete law of a resolved scene (`Scene::resolve`), if it has `[concrete]`.
+    pub fn from_scene(scene: &Scene) -> Option<ConcreteLaw> {
+        let c = scene.concrete.as_ref()?;
+        let get = |k: &str| scene.derived_value(k).unwrap_or(f64::NAN);
+        let cod_c = get("COD_c");
+        Some(ConcreteLaw {
+            e: scene.material.youngs_modulus(),
+            nu: scene.material.nu,
+            plane: scene.material.plane,
+            fc: get("fc"),
+            ft: get("ft"),
+            fy: get("fy"),
+            fult: get("fult"),
+            gf: get("Gf"),
+            cod_c,
+            cod_1: c.alpha * cod_c,
+            gamma: c.gamma,
+            eps_ult: c.eps_ult,
+            wt_cr: c.wt_cr,
+            wc_max: c.wc_max,
+            initiation: c.initiation,
+            crack_opening: c.crack_opening,
+            tensile_damage: c.tensile_damage,
+            compressive_damage: c.compressive_damage,
+            plasticity: c.plasticity,
+            crack_band: c.crack_band,
+        })
+    }
+
     /// A particle's values for E, f't, f'c and G_f: COD_c from (5.4) with the law's α and γ,
     /// f_y and f_ult in proportion to f'c.
     pub fn local(&self, e: f64, ft: f64, fc: f64, gf: f64) -> LocalProperties {
         let alpha = self.cod_1 / self.cod_c;
-        let cod_c = crate::material::concrete::critical_crack_opening(gf, ft, alpha, self.gamma);
+        let cod_c = crate::scene::concrete::critical_crack_opening(gf, ft, alpha, self.gamma);
         LocalProperties {
             e,
             ft,
@@ -121,17 +150,18 @@ pub fn initiates(law: &ConcreteLaw, p1: f64, p3: f64) -> bool {
 }
 
 /// Tensile damage (4.14) of an initiated particle with largest principal strain ε_I, so that
-/// (1−w_t)·E·ε_I follows the softening law at COD_eq = crack_band·ε_I (4.13), or, with
-/// [`CrackOpening::Inelastic`], at crack_band·(ε_I − ε_I,0) with ε_I,0 the strain at
-/// initiation. Returns 0 where ε_I ≤ 0 (the caller keeps the larger of old and new).
+/// (1−w_t)·E·ε_I follows the softening law at COD_eq = band·ε_I (4.13), or, with
+/// [`CrackOpening::Inelastic`], at band·(ε_I − ε_I,0) with ε_I,0 the strain at initiation;
+/// `band` is the particle's crack band in m (`crack_band`·L0,i). Returns 0 where ε_I ≤ 0
+/// (the caller keeps the larger of old and new).
 #[inline]
-pub fn tensile_damage(law: &ConcreteLaw, eps_i: f64, eps_at_initiation: f64) -> f64 {
+pub fn tensile_damage(law: &ConcreteLaw, band: f64, eps_i: f64, eps_at_initiation: f64) -> f64 {
     if eps_i <= 0.0 {
         return 0.0;
     }
     let cod = match law.crack_opening {
-        CrackOpening::Total => law.crack_band * eps_i,
-        CrackOpening::Inelastic => law.crack_band * (eps_i - eps_at_initiation),
+        CrackOpening::Total => band * eps_i,
+        CrackOpening::Inelastic => band * (eps_i - eps_at_initiation),
     };
     if cod >= law.cod_c {
         return 1.0;
@@ -222,7 +252,7 @@ mod tests {
             let e0 = l.ft / l.e;
             for f in [1.0, 1.5, 3.0, 10.0, 30.0] {
                 let eps = f * e0;
-                let w = tensile_damage(&l, eps, e0);
+                let w = tensile_damage(&l, l.crack_band, eps, e0);
                 let cod = match opening {
                     CrackOpening::Total => l.crack_band * eps,
                     CrackOpening::Inelastic => l.crack_band * (eps - e0),
@@ -232,7 +262,7 @@ mod tests {
             }
             // beyond COD_c the particle is fully damaged
             assert_eq!(
-                tensile_damage(&l, 2.0 * l.cod_c / l.crack_band + e0, e0),
+                tensile_damage(&l, l.crack_band, 2.0 * l.cod_c / l.crack_band + e0, e0),
                 1.0
             );
         }
@@ -240,8 +270,11 @@ mod tests {
         let l = law(CrackOpening::Total);
         let e0 = l.ft / l.e;
         let jump = (1.0 - l.gamma) * l.crack_band * e0 / l.cod_1;
-        assert!((tensile_damage(&l, e0, e0) - jump).abs() < 1e-12);
-        assert_eq!(tensile_damage(&law(CrackOpening::Inelastic), e0, e0), 0.0);
+        assert!((tensile_damage(&l, l.crack_band, e0, e0) - jump).abs() < 1e-12);
+        assert_eq!(
+            tensile_damage(&law(CrackOpening::Inelastic), 0.01, e0, e0),
+            0.0
+        );
     }
 
     #[test]

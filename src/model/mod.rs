@@ -1,9 +1,11 @@
 //! The SPLM/SPPM constitutive model: micro-moduli, stretch, force state, stress, strain,
 //! damage and plasticity.
 pub mod damage;
+pub mod damage_law;
 pub mod force_state;
 pub mod micro_modulus;
 pub mod plasticity;
 pub mod strain;
 pub mod stress;
 pub mod stretch;
+pub mod two_spring;

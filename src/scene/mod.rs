@@ -3,6 +3,7 @@
 //! `deny_unknown_fields`), and [`Scene::validate`] rejects impossible values, each with one
 //! message that names the key, the value and what is allowed.
 
+pub mod concrete;
 mod overrides;
 mod resolve;
 mod validate;
@@ -10,7 +11,7 @@ mod validate;
 pub use overrides::apply_overrides;
 pub use validate::SceneError;
 
-use crate::material::concrete::{Derived, Preset};
+use concrete::{Derived, Preset};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -4,8 +4,7 @@
 
 use super::validate::invalid;
 use super::*;
-use crate::material::concrete::{self as cc, Derived};
-use crate::model::damage::ConcreteLaw;
+use crate::scene::concrete::{self as cc, Derived};
 
 fn positive_opt(key: &str, v: Option<f64>) -> Result<(), SceneError> {
     match v {
@@ -243,34 +242,5 @@ impl Scene {
     /// A derived value by key (after [`Scene::resolve`]).
     pub fn derived_value(&self, key: &str) -> Option<f64> {
         self.derived.iter().find(|d| d.key == key).map(|d| d.value)
-    }
-
-    /// The concrete law of a resolved scene, if it has `[concrete]`.
-    pub fn concrete_law(&self) -> Option<ConcreteLaw> {
-        let c = self.concrete.as_ref()?;
-        let get = |k: &str| self.derived_value(k).unwrap_or(f64::NAN);
-        let cod_c = get("COD_c");
-        Some(ConcreteLaw {
-            e: self.material.youngs_modulus(),
-            nu: self.material.nu,
-            plane: self.material.plane,
-            fc: get("fc"),
-            ft: get("ft"),
-            fy: get("fy"),
-            fult: get("fult"),
-            gf: get("Gf"),
-            cod_c,
-            cod_1: c.alpha * cod_c,
-            gamma: c.gamma,
-            eps_ult: c.eps_ult,
-            wt_cr: c.wt_cr,
-            wc_max: c.wc_max,
-            initiation: c.initiation,
-            crack_opening: c.crack_opening,
-            tensile_damage: c.tensile_damage,
-            compressive_damage: c.compressive_damage,
-            plasticity: c.plasticity,
-            crack_band: c.crack_band * self.discretisation.spacing,
-        })
     }
 }

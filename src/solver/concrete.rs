@@ -26,57 +26,40 @@
 //! energy ¼·Σ_i[a·Σ_k L0·d_k·S_k² + b·(Σ_k √d_k·S_k)(Σ_k L0·√d_k·S_k)], so that the energy
 //! balance closes (tests/concrete.rs).
 //!
-//! **Decision (criteria stress).** Initiation (§8) and yield (§9) use σ_c = D·ε_d of the
-//! particle, ε_d the least-squares strain (see `model::strain`) of its damaged elastic
-//! stretches d_ij·S_e,ij, rather than (3.18). For an undamaged bulk particle the two are
-//! identical, and with damage they differ only by the d_ij on the b-term; but (3.18)
-//! under-reads at free surfaces (full ΔV, half the bonds) by up to ~60%, so cracks could
-//! neither start nor run through surface particles. The stress maps show (3.18).
+//! The damage law itself (initiation, softening, compressive damage, plasticity) is behind
+//! the `model::damage_law::DamageLaw` trait; the two-spring concrete law
+//! (`model::two_spring`) is one implementation. This kernel computes the kinematics, asks the
+//! law for each bond's damage factor and each particle's new state, and moves the particles.
 
 use super::kernel::central_difference;
 use super::mechanics::Mechanics;
 use super::KernelSet;
 use crate::discretise::{Particles, NONE};
-use crate::model::damage::{self, ConcreteLaw, LocalProperties};
+pub use crate::model::damage_law::ParticleDamage;
+use crate::model::damage_law::{DamageLaw, Kernel, ParticleBonds};
 use crate::model::force_state::{
     bond_energy, damaged_axial, damaged_bond_force, damaged_force_state, dilatation_term,
-    force_state,
 };
-use crate::model::micro_modulus::elasticity_matrix;
-use crate::model::plasticity;
 use crate::model::strain::{self, StrainFit};
 use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
-use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+use crate::model::two_spring::TwoSpring;
+use nalgebra::{Matrix2, Vector2};
 use rayon::prelude::*;
-
-/// The damage and plasticity state of one particle.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ParticleDamage {
-    /// Tensile damage w_t.
-    pub wt: f64,
-    /// Compressive damage w_c.
-    pub wc: f64,
-    /// ε_I when tensile damage started.
-    pub eps_init: f64,
-    pub initiated: bool,
-    /// Has yielded at least once.
-    pub yielded: bool,
-}
 
 /// Damage and plasticity of a run: the law, the per-particle geometry the kernel needs, and
 /// the committed and trial state.
 #[derive(Clone, Debug)]
-pub struct Concrete<const K: usize> {
-    pub law: ConcreteLaw,
-    /// Elasticity matrix D of the law (Voigt, engineering shear).
-    pub d: Matrix3<f64>,
+pub struct Concrete<const K: usize, L: DamageLaw<K> = TwoSpring> {
+    pub law: L,
     /// Least-squares strain projector of each particle (reference bond directions).
     pub fit: Vec<StrainFit<K>>,
     pub reverse: Vec<[u8; K]>,
-    /// Committed damage state (read by both passes of a step).
-    pub committed: Vec<ParticleDamage>,
-    trial: Vec<ParticleDamage>,
+    /// Each particle's length scale L0,i (m; the body's `length`).
+    pub length: Vec<f64>,
+    /// Committed law state (read by both passes of a step).
+    pub committed: Vec<L::State>,
+    trial: Vec<L::State>,
     /// Committed plastic stretch states S_Ps,ij (3.48), per slot.
     pub sps: Vec<[f64; K]>,
     sps_trial: Vec<[f64; K]>,
@@ -85,14 +68,11 @@ pub struct Concrete<const K: usize> {
     /// Run the full kernel even where the law needs only the tension kernel (for tests that
     /// compare the two).
     pub force_full: bool,
-    /// Each particle's own E, f't, f'c, G_f (random fields, MODEL.md §12); `None`: the law's
-    /// values everywhere.
-    pub local: Option<Vec<LocalProperties>>,
 }
 
-impl<const K: usize> Concrete<K> {
+impl<const K: usize, L: DamageLaw<K>> Concrete<K, L> {
     /// Undamaged, without plastic stretch.
-    pub fn new(law: ConcreteLaw, p: &Particles<2, K>) -> Self {
+    pub fn new(law: L, p: &Particles<2, K>) -> Self {
         let n = p.len();
         let fit = (0..n)
             .map(|i| {
@@ -108,23 +88,22 @@ impl<const K: usize> Concrete<K> {
             .collect();
         Concrete {
             law,
-            d: elasticity_matrix(law.e, law.nu, law.plane),
             fit,
             reverse: p.reverse.clone(),
-            committed: vec![ParticleDamage::default(); n],
-            trial: vec![ParticleDamage::default(); n],
+            length: p.length.clone(),
+            committed: vec![L::State::default(); n],
+            trial: vec![L::State::default(); n],
             sps: vec![[0.0; K]; n],
             sps_trial: vec![[0.0; K]; n],
             cache: vec![[SlotCache::default(); K]; n],
             force_full: false,
-            local: None,
         }
     }
 
-    /// The step kernel this law needs: the tension kernel unless it has compressive damage
-    /// or plasticity (ARCHITECTURE.md, "skip what the scene does not need").
+    /// The step kernel this law needs: the tension kernel unless it needs plastic stretch and
+    /// the compressive branch (ARCHITECTURE.md, "skip what the scene does not need").
     pub fn kernel(&self) -> KernelSet {
-        if self.force_full || self.law.compressive_damage || self.law.plasticity {
+        if self.force_full || self.law.kernel() == Kernel::Full {
             KernelSet::Full
         } else {
             KernelSet::Tension
@@ -135,6 +114,11 @@ impl<const K: usize> Concrete<K> {
     pub fn commit(&mut self) {
         std::mem::swap(&mut self.committed, &mut self.trial);
         std::mem::swap(&mut self.sps, &mut self.sps_trial);
+    }
+
+    /// Every particle's state as the outputs show it.
+    pub fn damage(&self) -> Vec<ParticleDamage> {
+        self.committed.iter().map(|s| self.law.view(s)).collect()
     }
 }
 
@@ -164,11 +148,11 @@ struct Slot {
 /// of a bond see the same elastic stretch and damage factor.
 ///
 /// With `FULL = false` (the tension kernel: no plasticity, no compressive damage) the plastic
-/// stretch is zero and w_c stays zero, so neither is read.
+/// stretch is zero, so it is not read.
 #[inline(always)]
-fn slot<const K: usize, const FULL: bool>(
+fn slot<const K: usize, L: DamageLaw<K>, const FULL: bool>(
     m: &Mechanics<2, K>,
-    c: &Concrete<K>,
+    c: &Concrete<K, L>,
     x: &[Vector2<f64>],
     i: usize,
     k: usize,
@@ -187,21 +171,9 @@ fn slot<const K: usize, const FULL: bool>(
     } else {
         st
     };
-    let (pi, pj) = (&c.committed[i], &c.committed[j]);
-    let (wi, wj) = if se >= 0.0 {
-        (pi.wt, pj.wt)
-    } else if FULL {
-        (pi.wc, pj.wc)
-    } else {
-        (0.0, 0.0)
-    };
-    // The undamaged bond (most of them) skips the division and the square root.
-    let (d, sd) = if wi == 0.0 && wj == 0.0 {
-        (1.0, 1.0)
-    } else {
-        let d = damage::damage_factor(wi, wj);
-        (d, d.sqrt())
-    };
+    let (d, sd) = c
+        .law
+        .bond_factor::<FULL>(&c.committed[i], &c.committed[j], se);
     Some(Slot {
         e: dx * (1.0 / len),
         st,
@@ -213,16 +185,16 @@ fn slot<const K: usize, const FULL: bool>(
 
 /// All slots of particle i and its damaged dilatation term bθ_i = b_i·Σ_m √d_im·S_e,im.
 #[inline(always)]
-fn slots<const K: usize, const FULL: bool>(
+fn slots<const K: usize, L: DamageLaw<K>, const FULL: bool>(
     m: &Mechanics<2, K>,
-    c: &Concrete<K>,
+    c: &Concrete<K, L>,
     x: &[Vector2<f64>],
     i: usize,
 ) -> ([Option<Slot>; K], f64) {
     let mut out = [None; K];
     let mut theta = 0.0;
     for (k, o) in out.iter_mut().enumerate() {
-        *o = slot::<K, FULL>(m, c, x, i, k);
+        *o = slot::<K, L, FULL>(m, c, x, i, k);
         if let Some(s) = o {
             theta += s.sd * s.se;
         }
@@ -230,19 +202,17 @@ fn slots<const K: usize, const FULL: bool>(
     (out, dilatation_term(m.b[i], theta))
 }
 
-/// Pass 1 for particle i: bθ_i, and the trial damage and plastic stretch state.
+/// Pass 1 for particle i: bθ_i, the slot cache for pass 2, and the trial law state and
+/// plastic stretch state (from the law, [`DamageLaw::update`]).
 ///
-/// `FULL = false` is the tension kernel (tensile damage only): it reads no plastic stretch and
-/// no w_c, and evaluates neither ε_eff, compressive damage nor the yield criterion. On a law
-/// without compressive damage and plasticity it gives the same numbers as `FULL = true`, bit
-/// for bit.
+/// `FULL = false` is the tension kernel: it reads no plastic stretch.
 #[inline]
-fn update_state<const K: usize, const FULL: bool>(
+fn update_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
     m: &Mechanics<2, K>,
-    c: &Concrete<K>,
+    c: &Concrete<K, L>,
     x: &[Vector2<f64>],
     i: usize,
-    trial: &mut ParticleDamage,
+    trial: &mut L::State,
     sps_trial: &mut [f64; K],
     cache: &mut [SlotCache; K],
 ) -> f64 {
@@ -257,7 +227,7 @@ fn update_state<const K: usize, const FULL: bool>(
     // stretch): one strain fit serves both.
     let mut same = true;
     for k in 0..K {
-        cache[k] = match slot::<K, FULL>(m, c, x, i, k) {
+        cache[k] = match slot::<K, L, FULL>(m, c, x, i, k) {
             Some(s) => {
                 let j = m.neighbours[i][k] as usize;
                 st[k] = s.st;
@@ -277,92 +247,30 @@ fn update_state<const K: usize, const FULL: bool>(
             None => SlotCache::default(),
         };
     }
-    let b_theta = dilatation_term(m.b[i], theta);
-    let local_law;
-    let law = match &c.local {
-        Some(l) => {
-            local_law = c.law.with(&l[i]);
-            &local_law
-        }
-        None => &c.law,
-    };
-    let mut p = c.committed[i];
+    *trial = c.committed[i];
     if FULL {
         *sps_trial = c.sps[i];
     }
-    if p.wt >= 1.0 && (p.wc >= 1.0 || !FULL) {
-        *trial = p;
-        return b_theta;
-    }
-    // Strains (§7): total for the damage law and ε_eff; the criteria stress from the damaged
-    // elastic stretches.
-    let fit = &c.fit[i];
-    let eps = strain::strain_tensor(fit, &st);
-    // The criteria stress D·ε_d, needed only to test initiation and yield.
-    let criteria_stress = || {
-        let eps_d = if same {
-            eps
-        } else {
-            strain::strain_tensor(fit, &dse)
-        };
-        // D is linear in E: a particle's own E scales the law's D.
-        let sv = (c.d * (law.e / c.law.e))
-            * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
-        Matrix2::new(sv[0], sv[2], sv[2], sv[1])
+    let bonds = ParticleBonds {
+        i,
+        fit: &c.fit[i],
+        total: &st,
+        elastic: &se,
+        damaged: &dse,
+        used: &used,
+        undamaged: same,
+        a: m.a[i],
+        b_theta_elastic: dilatation_term(m.b[i], theta_e),
+        length: c.length[i],
     };
-
-    // Tensile damage (§8).
-    let mut initiates_now = false;
-    if law.tensile_damage && !p.initiated {
-        let (s1, s2) = strain::principal_values(&criteria_stress());
-        let s33 = plasticity::out_of_plane_stress(s1, s2, law.nu, law.plane);
-        initiates_now = damage::initiates(law, s1.max(s33), s2.min(s33));
-    }
-    if !(FULL || p.initiated || initiates_now) {
-        *trial = p;
-        return b_theta;
-    }
-    let (e1, e2, e3) = strain::principal_strains(&eps, law.nu, law.plane);
-    if initiates_now {
-        p.initiated = true;
-        p.eps_init = e1;
-    }
-    if p.initiated {
-        p.wt = p.wt.max(damage::tensile_damage(law, e1, p.eps_init));
-    }
-    if FULL {
-        let eps_eff = damage::effective_strain(e1, e2, e3);
-        // Compressive damage (§9).
-        if law.compressive_damage {
-            p.wc = p.wc.max(damage::compressive_damage(law, p.wt, eps_eff));
-        }
-        // Plasticity (§9): yield on the criteria stress, flow along the deviatoric part of the
-        // undamaged force states (3.44).
-        if law.plasticity && p.wc < 1.0 {
-            let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
-            let ratio =
-                plasticity::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
-            if ratio >= 1.0 {
-                let mut fs = [0.0; K];
-                let bt = dilatation_term(m.b[i], theta_e);
-                for k in 0..K {
-                    if used[k] {
-                        fs[k] = force_state(m.a[i], se[k], bt);
-                    }
-                }
-                plasticity::flow(&fs, &used, ratio, law.fy / law.e, sps_trial);
-                p.yielded = true;
-            }
-        }
-    }
-    *trial = p;
-    b_theta
+    c.law.update::<FULL>(&bonds, trial, sps_trial);
+    dilatation_term(m.b[i], theta)
 }
 
 /// Pass 1 over all particles.
-fn pass_state<const K: usize, const FULL: bool>(
+fn pass_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
     m: &Mechanics<2, K>,
-    c: &mut Concrete<K>,
+    c: &mut Concrete<K, L>,
     x: &[Vector2<f64>],
     b_theta: &mut [f64],
 ) {
@@ -379,7 +287,7 @@ fn pass_state<const K: usize, const FULL: bool>(
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, (((bt, tr), sp), ca))| {
-                *bt = update_state::<K, FULL>(m, c, x, i, tr, sp, ca)
+                *bt = update_state::<K, L, FULL>(m, c, x, i, tr, sp, ca)
             });
     }
     c.trial = trial;
@@ -390,9 +298,9 @@ fn pass_state<const K: usize, const FULL: bool>(
 /// Internal force on particle i and the power of its bond dampers (half of each bond's),
 /// from the slot cache pass 1 left and every particle's bθ.
 #[inline]
-fn particle_force<const K: usize, const DAMP: bool>(
+fn particle_force<const K: usize, L: DamageLaw<K>, const DAMP: bool>(
     m: &Mechanics<2, K>,
-    c: &Concrete<K>,
+    c: &Concrete<K, L>,
     v: &[Vector2<f64>],
     b_theta: &[f64],
     i: usize,
@@ -420,15 +328,21 @@ fn particle_force<const K: usize, const DAMP: bool>(
 /// (not yet swapped in), `force` (the internal force at x^n) and the damper work; then the
 /// trial state is committed. With `LAG`, the force of the previous step drives this one
 /// (reading A of MODEL.md §4; `force_prev` holds it). `FULL = false` is the tension kernel
-/// (see [`update_state`]), valid only for a law without compressive damage and plasticity.
-pub fn step<const K: usize, const LAG: bool, const DAMP: bool, const FULL: bool>(
+/// (see [`update_state`]), valid only for a law that needs no more ([`Kernel::Tension`]).
+pub fn step<
+    const K: usize,
+    L: DamageLaw<K>,
+    const LAG: bool,
+    const DAMP: bool,
+    const FULL: bool,
+>(
     m: &Mechanics<2, K>,
-    c: &mut Concrete<K>,
+    c: &mut Concrete<K, L>,
     st: &mut super::kernel::State<2>,
     dt: f64,
 ) {
     debug_assert!(FULL || c.kernel() == KernelSet::Tension);
-    pass_state::<K, FULL>(m, c, &st.x, &mut st.b_theta);
+    pass_state::<K, L, FULL>(m, c, &st.x, &mut st.b_theta);
     {
         let c = &*c;
         let (x, v, bt, fp) = (&st.x[..], &st.v[..], &st.b_theta[..], &st.force_prev[..]);
@@ -440,7 +354,7 @@ pub fn step<const K: usize, const LAG: bool, const DAMP: bool, const FULL: bool>
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, (((xn, vn), fo), dw))| {
-                let (f, bond_power) = particle_force::<K, DAMP>(m, c, v, bt, i);
+                let (f, bond_power) = particle_force::<K, L, DAMP>(m, c, v, bt, i);
                 *fo = f;
                 let drive = if LAG { fp[i] } else { f };
                 central_difference::<2, K, DAMP>(
@@ -453,35 +367,40 @@ pub fn step<const K: usize, const LAG: bool, const DAMP: bool, const FULL: bool>
 
 /// Internal forces (bonds only, no dampers) at positions x with the committed state; the
 /// trial state is left as the step would compute it. For tests and post-processing.
-pub fn internal_forces<const K: usize>(
+pub fn internal_forces<const K: usize, L: DamageLaw<K>>(
     m: &Mechanics<2, K>,
-    c: &mut Concrete<K>,
+    c: &mut Concrete<K, L>,
     x: &[Vector2<f64>],
 ) -> Vec<Vector2<f64>> {
     let mut bt = vec![0.0; x.len()];
     match c.kernel() {
-        KernelSet::Tension => pass_state::<K, false>(m, c, x, &mut bt),
-        _ => pass_state::<K, true>(m, c, x, &mut bt),
+        KernelSet::Tension => pass_state::<K, L, false>(m, c, x, &mut bt),
+        _ => pass_state::<K, L, true>(m, c, x, &mut bt),
     }
     let c = &*c;
     (0..x.len())
-        .map(|i| particle_force::<K, false>(m, c, x, &bt, i).0)
+        .map(|i| particle_force::<K, L, false>(m, c, x, &bt, i).0)
         .collect()
 }
 
 /// Elastic energy stored in the damaged bonds at positions x with the committed state,
 /// U = ¼·Σ_i Σ_k L0,k·S_e,k·(d_k·a_i·S_e,k + √d_k·bθ_i) (with fixed d and S_P,
 /// ∂U/∂L_ij = F_b,ij for equal bond lengths, as in the lattice).
-pub fn internal_energy<const K: usize>(
+///
+/// The particles' energies are computed in parallel and summed in particle order, so the
+/// sum does not depend on the thread count or the scheduling (a parallel reduction's tree
+/// does: rayon splits work where threads steal it, and the old `par_iter().sum()` gave
+/// dissipated energies that differed in the last bits from run to run).
+pub fn internal_energy<const K: usize, L: DamageLaw<K>>(
     m: &Mechanics<2, K>,
-    c: &Concrete<K>,
+    c: &Concrete<K, L>,
     x: &[Vector2<f64>],
 ) -> f64 {
-    (0..x.len())
+    let per_particle: Vec<f64> = (0..x.len())
         .into_par_iter()
         .with_min_len(256)
         .map(|i| {
-            let (sl, bt) = slots::<K, true>(m, c, x, i);
+            let (sl, bt) = slots::<K, L, true>(m, c, x, i);
             let mut u = 0.0;
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
@@ -491,20 +410,21 @@ pub fn internal_energy<const K: usize>(
             }
             0.25 * u
         })
-        .sum()
+        .collect();
+    per_particle.iter().sum()
 }
 
 /// Particle stresses (3.18) of particles of volume ΔV with the damaged force states
 /// F_s,ij = d_ij·a_i·S_e,ij + √d_ij·bθ_i.
-pub fn particle_stress<const K: usize>(
+pub fn particle_stress<const K: usize, L: DamageLaw<K>>(
     m: &Mechanics<2, K>,
-    c: &Concrete<K>,
+    c: &Concrete<K, L>,
     x: &[Vector2<f64>],
     volume: &[f64],
 ) -> Vec<Matrix2<f64>> {
     (0..x.len())
         .map(|i| {
-            let (sl, bt) = slots::<K, true>(m, c, x, i);
+            let (sl, bt) = slots::<K, L, true>(m, c, x, i);
             let mut acc = StressSum::default();
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
@@ -534,12 +454,25 @@ pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
     );
     /// Elastic energy at positions x.
     fn internal_energy(&self, m: &Mechanics<D, K>, x: &[nalgebra::SVector<f64, D>]) -> f64;
-    /// The damage state.
-    fn concrete(&self) -> &Concrete<K>;
-    fn concrete_mut(&mut self) -> &mut Concrete<K>;
+    /// The step kernel it runs.
+    fn kernel(&self) -> KernelSet;
+    /// Every particle's damage as the outputs show it.
+    fn damage(&self) -> Vec<ParticleDamage>;
+    /// Whether some particle has failed (w_t or w_c ≥ 0.99).
+    fn has_failed_particle(&self) -> bool;
+    /// Particle stresses (3.18) at positions x.
+    fn particle_stress(
+        &self,
+        m: &Mechanics<D, K>,
+        x: &[nalgebra::SVector<f64, D>],
+        volume: &[f64],
+    ) -> Vec<nalgebra::SMatrix<f64, D, D>>;
+    /// The model itself, for tests that reach into its state (downcast to its type).
+    fn as_any(&self) -> &dyn std::any::Any;
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
 }
 
-impl<const K: usize> Inelastic<2, K> for Concrete<K> {
+impl<const K: usize, L: DamageLaw<K>> Inelastic<2, K> for Concrete<K, L> {
     fn step(
         &mut self,
         m: &Mechanics<2, K>,
@@ -550,23 +483,52 @@ impl<const K: usize> Inelastic<2, K> for Concrete<K> {
     ) {
         let full = self.kernel() == KernelSet::Full;
         match (lag, damp, full) {
-            (false, false, false) => step::<K, false, false, false>(m, self, st, dt),
-            (false, true, false) => step::<K, false, true, false>(m, self, st, dt),
-            (true, false, false) => step::<K, true, false, false>(m, self, st, dt),
-            (true, true, false) => step::<K, true, true, false>(m, self, st, dt),
-            (false, false, true) => step::<K, false, false, true>(m, self, st, dt),
-            (false, true, true) => step::<K, false, true, true>(m, self, st, dt),
-            (true, false, true) => step::<K, true, false, true>(m, self, st, dt),
-            (true, true, true) => step::<K, true, true, true>(m, self, st, dt),
+            (false, false, false) => step::<K, L, false, false, false>(m, self, st, dt),
+            (false, true, false) => step::<K, L, false, true, false>(m, self, st, dt),
+            (true, false, false) => step::<K, L, true, false, false>(m, self, st, dt),
+            (true, true, false) => step::<K, L, true, true, false>(m, self, st, dt),
+            (false, false, true) => step::<K, L, false, false, true>(m, self, st, dt),
+            (false, true, true) => step::<K, L, false, true, true>(m, self, st, dt),
+            (true, false, true) => step::<K, L, true, false, true>(m, self, st, dt),
+            (true, true, true) => step::<K, L, true, true, true>(m, self, st, dt),
         }
     }
     fn internal_energy(&self, m: &Mechanics<2, K>, x: &[Vector2<f64>]) -> f64 {
         internal_energy(m, self, x)
     }
-    fn concrete(&self) -> &Concrete<K> {
+    fn kernel(&self) -> KernelSet {
+        Concrete::kernel(self)
+    }
+    fn damage(&self) -> Vec<ParticleDamage> {
+        Concrete::damage(self)
+    }
+    fn has_failed_particle(&self) -> bool {
+        self.committed.iter().any(|s| self.law.view(s).failed())
+    }
+    fn particle_stress(
+        &self,
+        m: &Mechanics<2, K>,
+        x: &[Vector2<f64>],
+        volume: &[f64],
+    ) -> Vec<Matrix2<f64>> {
+        particle_stress(m, self, x, volume)
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
         self
     }
-    fn concrete_mut(&mut self) -> &mut Concrete<K> {
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
         self
+    }
+}
+
+impl<const K: usize> dyn Inelastic<2, K> {
+    /// The two-spring concrete model, if this is one (for tests that reach into its state).
+    pub fn concrete(&self) -> Option<&Concrete<K>> {
+        self.as_any().downcast_ref()
+    }
+
+    /// [`Self::concrete`], mutable.
+    pub fn concrete_mut(&mut self) -> Option<&mut Concrete<K>> {
+        self.as_any_mut().downcast_mut()
     }
 }

@@ -24,8 +24,8 @@ pub struct Mechanics<const D: usize, const K: usize> {
 }
 
 impl<const D: usize, const K: usize> Mechanics<D, K> {
-    /// Model with the given micro-moduli and density; dampers off.
-    pub fn new(p: &Particles<D, K>, a: Vec<f64>, b: Vec<f64>, rho: &[f64]) -> Self {
+    /// Model of a body with its micro-moduli (`p.a`, `p.b`) and density; dampers off.
+    pub fn new(p: &Particles<D, K>, rho: &[f64]) -> Self {
         let n = p.len();
         // The kernel's unchecked gathers rely on this.
         assert!(
@@ -51,8 +51,8 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
         Mechanics {
             neighbours: p.neighbours.clone(),
             inv_l0,
-            a,
-            b,
+            a: p.a.clone(),
+            b: p.b.clone(),
             inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
             mass,
             c_in: vec![0.0; n],

@@ -253,18 +253,15 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
 
     /// Whether some particle has failed (w_t or w_c ≥ 0.99); never for the elastic kernel.
     pub fn has_failed_particle(&self) -> bool {
-        self.inelastic.as_ref().is_some_and(|m| {
-            m.concrete()
-                .committed
-                .iter()
-                .any(|p| p.wt >= 0.99 || p.wc >= 0.99)
-        })
+        self.inelastic
+            .as_ref()
+            .is_some_and(|m| m.has_failed_particle())
     }
 
     /// The step kernel this simulation runs.
     pub fn kernel(&self) -> KernelSet {
         match &self.inelastic {
-            Some(model) => model.concrete().kernel(),
+            Some(model) => model.kernel(),
             None => KernelSet::Elastic,
         }
     }

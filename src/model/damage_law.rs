@@ -1,0 +1,116 @@
+//! Damage laws behind a trait (MODEL.md §6): what a material's damage and plasticity decide,
+//! apart from the kernel that moves the particles (`solver::concrete`).
+//!
+//! The kernel owns the kinematics: for each particle it computes, bond by bond, the total
+//! stretch S_T, the elastic stretch S_e = S_T − S_P (3.38), the damage factor d the law
+//! gives the bond, the dilatation term, the bond forces (through `model::force_state`) and
+//! the time integration; it keeps each particle's committed and trial law state and the
+//! plastic stretch states S_Ps, and commits them once per step. The law decides the rest.
+//!
+//! # Adding a damage law
+//!
+//! A new law (say the bond-based bilinear softening of seed 000, or the failure criteria of
+//! seed 001) implements [`DamageLaw`] and nothing else; neither the kernel nor the pipeline
+//! changes:
+//!
+//! 1. `type State`: what one particle remembers (e.g. the largest stretch reached), `Copy`
+//!    and `Default` (the undamaged state).
+//! 2. [`DamageLaw::kernel`]: whether the kernel must carry plastic stretch and read the
+//!    compressive branch ([`Kernel::Full`]) or not ([`Kernel::Tension`]).
+//! 3. [`DamageLaw::bond_factor`]: the factor d ∈ [0, 1] (and √d) a bond between two particles
+//!    carries, from their committed states and the sign of its elastic stretch. It must be
+//!    symmetric bit for bit in (i, j), so that the two ends of a bond see the same force.
+//! 4. [`DamageLaw::update`]: the particle's trial state (and plastic stretch increments, for a
+//!    [`Kernel::Full`] law) from its bonds' stretches ([`ParticleBonds`]: total, elastic,
+//!    damaged, the strain fit, its micro-modulus and length scale).
+//! 5. [`DamageLaw::view`]: the state as the outputs show it ([`ParticleDamage`]).
+//!
+//! Then `run` builds `solver::concrete::Concrete::<K, YourLaw>::new(law, &body)` where it
+//! builds the two-spring law today.
+
+use super::strain::StrainFit;
+
+/// Which kernel a law needs (the solver's `KernelSet` without the elastic one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// Tensile damage only: no plastic stretch, no compressive branch.
+    Tension,
+    /// Plastic stretch and the compressive branch.
+    Full,
+}
+
+/// A particle's damage and plasticity as the outputs show them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ParticleDamage {
+    /// Tensile damage w_t.
+    pub wt: f64,
+    /// Compressive damage w_c.
+    pub wc: f64,
+    /// ε_I when tensile damage started.
+    pub eps_init: f64,
+    pub initiated: bool,
+    /// Has yielded at least once.
+    pub yielded: bool,
+}
+
+impl ParticleDamage {
+    /// Whether the particle has failed (w_t or w_c ≥ 0.99).
+    pub fn failed(&self) -> bool {
+        self.wt >= 0.99 || self.wc >= 0.99
+    }
+}
+
+/// What the kernel hands a law about one particle's bonds at the current positions, slot by
+/// slot (0 and `used = false` in empty slots).
+pub struct ParticleBonds<'a, const K: usize> {
+    /// The particle.
+    pub i: usize,
+    /// Its least-squares strain projector (`model::strain`).
+    pub fit: &'a StrainFit<K>,
+    /// Total stretches S_T.
+    pub total: &'a [f64; K],
+    /// Elastic stretches S_e = S_T − S_P.
+    pub elastic: &'a [f64; K],
+    /// Damaged elastic stretches d·S_e.
+    pub damaged: &'a [f64; K],
+    pub used: &'a [bool; K],
+    /// Whether the damaged elastic stretches equal the total ones (no damage, no plastic
+    /// stretch): one strain serves both.
+    pub undamaged: bool,
+    /// Micro-modulus a_i.
+    pub a: f64,
+    /// The undamaged dilatation term b_i·Σ S_e (for the force states of plastic flow).
+    pub b_theta_elastic: f64,
+    /// The particle's length scale L0,i (m), e.g. for the crack band.
+    pub length: f64,
+}
+
+/// A damage law (see the module documentation for how to add one).
+pub trait DamageLaw<const K: usize>: Send + Sync + 'static {
+    /// What one particle remembers; `Default` is undamaged.
+    type State: Copy + Default + Send + Sync + PartialEq + std::fmt::Debug + 'static;
+
+    /// The kernel this law needs.
+    fn kernel(&self) -> Kernel;
+
+    /// (d, √d) of a bond between particles in states `i` and `j` with elastic stretch
+    /// `elastic_stretch`; `FULL` is the kernel running ([`Kernel::Full`]).
+    fn bond_factor<const FULL: bool>(
+        &self,
+        i: &Self::State,
+        j: &Self::State,
+        elastic_stretch: f64,
+    ) -> (f64, f64);
+
+    /// Update `state` (the committed state on entry, the trial state on exit) and, with
+    /// `FULL`, the plastic stretch states `sps` (committed on entry) of particle `bonds.i`.
+    fn update<const FULL: bool>(
+        &self,
+        bonds: &ParticleBonds<'_, K>,
+        state: &mut Self::State,
+        sps: &mut [f64; K],
+    );
+
+    /// The state as the outputs show it.
+    fn view(&self, state: &Self::State) -> ParticleDamage;
+}

@@ -1,0 +1,166 @@
+//! The two-spring concrete law (MODEL.md §6–9) as a [`DamageLaw`]: tensile damage by
+//! Rankine or interaction initiation and bilinear softening over a crack band, compressive
+//! damage, and plasticity with linear hardening.
+//!
+//! **Decision (criteria stress).** Initiation (§8) and yield (§9) use σ_c = D·ε_d of the
+//! particle, ε_d the least-squares strain (see `model::strain`) of its damaged elastic
+//! stretches d_ij·S_e,ij, rather than (3.18). For an undamaged bulk particle the two are
+//! identical, and with damage they differ only by the d_ij on the b-term; but (3.18)
+//! under-reads at free surfaces (full ΔV, half the bonds) by up to ~60%, so cracks could
+//! neither start nor run through surface particles. The stress maps show (3.18).
+
+use super::damage::{self, ConcreteLaw, LocalProperties};
+use super::damage_law::{DamageLaw, Kernel, ParticleBonds, ParticleDamage};
+use super::force_state::force_state;
+use super::micro_modulus::elasticity_matrix;
+use super::plasticity;
+use super::strain;
+use nalgebra::{Matrix2, Matrix3, Vector3};
+
+/// The two-spring law of a run: the concrete law, its elasticity matrix and, with random
+/// fields, each particle's own E, f't, f'c and G_f.
+#[derive(Clone, Debug)]
+pub struct TwoSpring {
+    pub law: ConcreteLaw,
+    /// Elasticity matrix D of the law (Voigt, engineering shear).
+    pub d: Matrix3<f64>,
+    /// Each particle's own values (random fields, MODEL.md §12); `None`: the law's values
+    /// everywhere.
+    pub local: Option<Vec<LocalProperties>>,
+}
+
+impl TwoSpring {
+    pub fn new(law: ConcreteLaw, local: Option<Vec<LocalProperties>>) -> Self {
+        TwoSpring {
+            law,
+            d: elasticity_matrix(law.e, law.nu, law.plane),
+            local,
+        }
+    }
+}
+
+impl<const K: usize> DamageLaw<K> for TwoSpring {
+    type State = ParticleDamage;
+
+    /// The tension kernel unless the law has compressive damage or plasticity
+    /// (ARCHITECTURE.md, "skip what the scene does not need").
+    fn kernel(&self) -> Kernel {
+        if self.law.compressive_damage || self.law.plasticity {
+            Kernel::Full
+        } else {
+            Kernel::Tension
+        }
+    }
+
+    /// The two springs in series (3.37) with the tensile damage of both particles where the
+    /// bond is stretched, the compressive damage where it is shortened (the tension kernel
+    /// has none). Computed identically from either end of the bond.
+    #[inline(always)]
+    fn bond_factor<const FULL: bool>(
+        &self,
+        pi: &ParticleDamage,
+        pj: &ParticleDamage,
+        se: f64,
+    ) -> (f64, f64) {
+        let (wi, wj) = if se >= 0.0 {
+            (pi.wt, pj.wt)
+        } else if FULL {
+            (pi.wc, pj.wc)
+        } else {
+            (0.0, 0.0)
+        };
+        // The undamaged bond (most of them) skips the division and the square root.
+        if wi == 0.0 && wj == 0.0 {
+            (1.0, 1.0)
+        } else {
+            let d = damage::damage_factor(wi, wj);
+            (d, d.sqrt())
+        }
+    }
+
+    /// Tensile initiation and damage (§8), compressive damage and plastic flow (§9).
+    /// `FULL = false` (the tension kernel) evaluates neither ε_eff, compressive damage nor the
+    /// yield criterion; on a law without them it gives the same numbers as `FULL = true`.
+    #[inline(always)]
+    fn update<const FULL: bool>(
+        &self,
+        b: &ParticleBonds<'_, K>,
+        p: &mut ParticleDamage,
+        sps: &mut [f64; K],
+    ) {
+        if p.wt >= 1.0 && (p.wc >= 1.0 || !FULL) {
+            return;
+        }
+        let local_law;
+        let law = match &self.local {
+            Some(l) => {
+                local_law = self.law.with(&l[b.i]);
+                &local_law
+            }
+            None => &self.law,
+        };
+        // Strains (§7): total for the damage law and ε_eff; the criteria stress from the
+        // damaged elastic stretches.
+        let eps = strain::strain_tensor(b.fit, b.total);
+        // The criteria stress D·ε_d, needed only to test initiation and yield.
+        let criteria_stress = || {
+            let eps_d = if b.undamaged {
+                eps
+            } else {
+                strain::strain_tensor(b.fit, b.damaged)
+            };
+            // D is linear in E: a particle's own E scales the law's D.
+            let sv = (self.d * (law.e / self.law.e))
+                * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
+            Matrix2::new(sv[0], sv[2], sv[2], sv[1])
+        };
+
+        // Tensile damage (§8).
+        let mut initiates_now = false;
+        if law.tensile_damage && !p.initiated {
+            let (s1, s2) = strain::principal_values(&criteria_stress());
+            let s33 = plasticity::out_of_plane_stress(s1, s2, law.nu, law.plane);
+            initiates_now = damage::initiates(law, s1.max(s33), s2.min(s33));
+        }
+        if !(FULL || p.initiated || initiates_now) {
+            return;
+        }
+        let (e1, e2, e3) = strain::principal_strains(&eps, law.nu, law.plane);
+        if initiates_now {
+            p.initiated = true;
+            p.eps_init = e1;
+        }
+        if p.initiated {
+            let band = law.crack_band * b.length;
+            p.wt = p.wt.max(damage::tensile_damage(law, band, e1, p.eps_init));
+        }
+        if FULL {
+            let eps_eff = damage::effective_strain(e1, e2, e3);
+            // Compressive damage (§9).
+            if law.compressive_damage {
+                p.wc = p.wc.max(damage::compressive_damage(law, p.wt, eps_eff));
+            }
+            // Plasticity (§9): yield on the criteria stress, flow along the deviatoric part of
+            // the undamaged force states (3.44).
+            if law.plasticity && p.wc < 1.0 {
+                let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
+                let ratio =
+                    plasticity::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
+                if ratio >= 1.0 {
+                    let mut fs = [0.0; K];
+                    for k in 0..K {
+                        if b.used[k] {
+                            fs[k] = force_state(b.a, b.elastic[k], b.b_theta_elastic);
+                        }
+                    }
+                    plasticity::flow(&fs, b.used, ratio, law.fy / law.e, sps);
+                    p.yielded = true;
+                }
+            }
+        }
+    }
+
+    fn view(&self, state: &ParticleDamage) -> ParticleDamage {
+        *state
+    }
+}
