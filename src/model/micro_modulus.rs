@@ -7,9 +7,15 @@
 //! and contributes (L0/(2ΔV))·F_s·v to the stress (3.18). With F_s,ij = a·S_ij + b·Σ_m S_im,
 //! the particle's stiffness is D_i = a·A + b·B with
 //! A = Σ_j w_j v_j v_jᵀ and B = (Σ_j w_j v_j)(Σ_k v_k)ᵀ, w_j = L0,j/(2ΔV).
+//!
+//! The 2D functions here are wrappers over `model::dimension`, which gives the same in 3D
+//! (Voigt [xx, yy, zz, yz, xz, xy], v = [nx², ny², nz², ny·nz, nx·nz, nx·ny]). For the FCC
+//! lattice, F_s,ij = (a + c·[j ∈ N_II])·S_ij + b·Σ_m S_im (MODEL.md §3 with its erratum), so
+//! D_i = a·A + b·B + c·C with C = Σ_{j ∈ N_II} w_j v_j v_jᵀ ([`fcc_basis`], [`fit_fcc`]).
 
+use super::dimension::{least_squares, Dim, Dimension};
 use crate::scene::Plane;
-use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector2, Vector3};
 
 /// Micro-elastic constants of one particle (N; per unit stretch).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,59 +36,22 @@ pub fn hexagonal(e: f64, nu: f64, l0: f64, t: f64, plane: Plane) -> MicroModuli 
 }
 
 /// Isotropic elasticity matrix D (Voigt, engineering shear) for plane stress or strain.
+/// 2D wrapper of [`Dimension::elasticity`].
 pub fn elasticity_matrix(e: f64, nu: f64, plane: Plane) -> Matrix3<f64> {
-    match plane {
-        Plane::Stress => {
-            let c = e / (1.0 - nu * nu);
-            Matrix3::new(
-                c,
-                c * nu,
-                0.0,
-                c * nu,
-                c,
-                0.0,
-                0.0,
-                0.0,
-                c * (1.0 - nu) / 2.0,
-            )
-        }
-        Plane::Strain => {
-            let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
-            Matrix3::new(
-                c * (1.0 - nu),
-                c * nu,
-                0.0,
-                c * nu,
-                c * (1.0 - nu),
-                0.0,
-                0.0,
-                0.0,
-                c * (1.0 - 2.0 * nu) / 2.0,
-            )
-        }
-    }
+    <Dim<2> as Dimension<2>>::elasticity(e, nu, plane)
 }
 
-/// v = [nx², ny², nx·ny] of a unit bond direction: S = v·ε.
+/// v = [nx², ny², nx·ny] of a unit bond direction: S = v·ε. 2D wrapper of
+/// [`Dimension::projector`].
 #[inline]
 pub fn strain_projector(n: &Vector2<f64>) -> Vector3<f64> {
-    Vector3::new(n.x * n.x, n.y * n.y, n.x * n.y)
+    <Dim<2> as Dimension<2>>::projector(n)
 }
 
 /// The matrices A and B of a particle with bonds (unit direction, reference length) and
-/// volume ΔV: D_i = a·A + b·B.
+/// volume ΔV: D_i = a·A + b·B. 2D wrapper of [`Dimension::stiffness_basis`].
 pub fn stiffness_basis(bonds: &[(Vector2<f64>, f64)], volume: f64) -> (Matrix3<f64>, Matrix3<f64>) {
-    let mut a = Matrix3::zeros();
-    let mut mv = Vector3::zeros();
-    let mut nv = Vector3::zeros();
-    for (n, l0) in bonds {
-        let v = strain_projector(n);
-        let w = l0 / (2.0 * volume);
-        a += v * v.transpose() * w;
-        mv += v * w;
-        nv += v;
-    }
-    (a, mv * nv.transpose())
+    <Dim<2> as Dimension<2>>::stiffness_basis(bonds, volume)
 }
 
 /// Result of the least-squares fit of one particle.
@@ -94,28 +63,76 @@ pub struct Fit {
 }
 
 /// Least-squares a, b with D ≈ a·A + b·B (3.20). Returns `None` when the bonds cannot carry
-/// the fit (fewer than three independent directions, or a non-positive a).
+/// the fit (fewer than three independent directions, or a non-positive a). 2D wrapper of
+/// [`Dimension::fit`].
 pub fn fit(bonds: &[(Vector2<f64>, f64)], volume: f64, d: &Matrix3<f64>) -> Option<Fit> {
-    let (a_m, b_m) = stiffness_basis(bonds, volume);
-    let dot = |x: &Matrix3<f64>, y: &Matrix3<f64>| x.component_mul(y).sum();
-    let g = Matrix2::new(
-        dot(&a_m, &a_m),
-        dot(&a_m, &b_m),
-        dot(&b_m, &a_m),
-        dot(&b_m, &b_m),
-    );
-    let r = Vector2::new(dot(&a_m, d), dot(&b_m, d));
-    // A must have full rank (three independent v_j) for the particle to resist every strain.
-    if a_m.determinant().abs() <= 1e-12 * a_m.norm().powi(3) {
-        return None;
-    }
-    let sol = g.try_inverse()? * r;
-    let moduli = MicroModuli { a: sol.x, b: sol.y };
-    if !(moduli.a > 0.0 && moduli.a.is_finite() && moduli.b.is_finite()) {
-        return None;
-    }
-    let residual = (a_m * moduli.a + b_m * moduli.b - d).norm() / d.norm();
-    Some(Fit { moduli, residual })
+    <Dim<2> as Dimension<2>>::fit(bonds, volume, d)
+}
+
+/// Micro-elastic constants of an FCC particle (N; per unit stretch): F_s,ij =
+/// (a + c·[j ∈ N_II])·S_ij + b·Σ_m S_im (MODEL.md §3 with its erratum: c acts on the
+/// second-neighbour bond's own stretch, so second neighbours have modulus a + c).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FccModuli {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+}
+
+/// Constants (4.8) of a bulk particle of the FCC lattice with nearest spacing L0
+/// (ΔV = (√2/2)·L0³): a = E·L0²/(√2·(1+ν)), b = (√2−1)·E·L0²·(1−4ν)/(24·(2ν−1)·(1+ν)),
+/// c = (1/(2√2) − 1)·a. They reproduce isotropic D exactly
+/// (`tests::fcc_constants_reproduce_isotropic_elasticity`).
+pub fn fcc(e: f64, nu: f64, l0: f64) -> FccModuli {
+    let s2 = 2f64.sqrt();
+    let a = e * l0 * l0 / (s2 * (1.0 + nu));
+    let b = (s2 - 1.0) * e * l0 * l0 * (1.0 - 4.0 * nu) / (24.0 * (2.0 * nu - 1.0) * (1.0 + nu));
+    let c = (1.0 / (2.0 * s2) - 1.0) * a;
+    FccModuli { a, b, c }
+}
+
+/// Volume ΔV = (√2/2)·L0³ of a bulk FCC particle with nearest spacing L0.
+pub fn fcc_volume(l0: f64) -> f64 {
+    0.5 * 2f64.sqrt() * l0 * l0 * l0
+}
+
+/// A bond of a 3D particle for the FCC stiffness: unit direction, reference length, and
+/// whether it is a second neighbour (N_II, modulus a + c).
+pub type FccBond = (Vector3<f64>, f64, bool);
+
+/// The bases A, B (all bonds, see [`Dimension::stiffness_basis`]) and C = Σ_{j ∈ N_II}
+/// w_j·v_j·v_jᵀ of an FCC particle: D_i = a·A + b·B + c·C.
+pub fn fcc_basis(bonds: &[FccBond], volume: f64) -> (Matrix6<f64>, Matrix6<f64>, Matrix6<f64>) {
+    let all: Vec<(Vector3<f64>, f64)> = bonds.iter().map(|&(n, l0, _)| (n, l0)).collect();
+    let second: Vec<(Vector3<f64>, f64)> = bonds
+        .iter()
+        .filter(|b| b.2)
+        .map(|&(n, l0, _)| (n, l0))
+        .collect();
+    let (a_m, b_m) = <Dim<3> as Dimension<3>>::stiffness_basis(&all, volume);
+    let (c_m, _) = <Dim<3> as Dimension<3>>::stiffness_basis(&second, volume);
+    (a_m, b_m, c_m)
+}
+
+/// Result of the least-squares (a, b, c) fit of an FCC particle.
+#[derive(Clone, Copy, Debug)]
+pub struct FccFit {
+    pub moduli: FccModuli,
+    /// ‖a·A + b·B + c·C − D‖_F / ‖D‖_F.
+    pub residual: f64,
+}
+
+/// Least-squares a, b, c with D ≈ a·A + b·B + c·C (3.20) for an FCC particle (e.g. the
+/// surface correction of one with missing bonds). `None` when A is rank deficient, the
+/// Gram matrix singular (e.g. no second neighbours: fit (a, b) with [`Dimension::fit`]),
+/// a ≤ 0 or, with second neighbours, a + c ≤ 0.
+pub fn fit_fcc(bonds: &[FccBond], volume: f64, d: &Matrix6<f64>) -> Option<FccFit> {
+    let (a_m, b_m, c_m) = fcc_basis(bonds, volume);
+    let ([a, b, c], residual) = least_squares(&[a_m, b_m, c_m], d, |x| x[0] + x[2] > 0.0)?;
+    Some(FccFit {
+        moduli: FccModuli { a, b, c },
+        residual,
+    })
 }
 
 #[cfg(test)]

@@ -1,7 +1,8 @@
 //! The SPLM/SPPM constitutive model: micro-moduli, stretch, force state, stress, strain,
-//! damage and plasticity.
+//! damage and plasticity, in 2D and 3D (`dimension`: dimension as a type).
 pub mod damage;
 pub mod damage_law;
+pub mod dimension;
 pub mod force_state;
 pub mod micro_modulus;
 pub mod plasticity;

@@ -4,26 +4,20 @@
 //! F_eff^(2/3), which is dimensionally inconsistent; the yield ratio is the von Mises form
 //! √(3/2)·‖σ_dev‖/F_eff, yielding at 1.
 
+use super::dimension::{Dim, Dimension};
 use crate::scene::Plane;
 use nalgebra::Matrix2;
 
 /// Out-of-plane stress σ_zz of a 2D particle: 0 in plane stress, ν·(σxx + σyy) (equally
 /// ν·(σ1 + σ2)) in plane strain.
-#[inline(always)]
-pub fn out_of_plane_stress(sxx: f64, syy: f64, nu: f64, plane: Plane) -> f64 {
-    match plane {
-        Plane::Stress => 0.0,
-        Plane::Strain => nu * (sxx + syy),
-    }
-}
+pub use super::dimension::out_of_plane_stress;
 
 /// Von Mises equivalent stress √(3/2)·‖σ_dev‖ ((3.39), (3.40)) of a 2D particle from its
-/// in-plane stress, with σ_zz from [`out_of_plane_stress`].
+/// in-plane stress, with σ_zz from [`out_of_plane_stress`]. 2D wrapper of
+/// [`Dimension::equivalent_stress`].
 #[inline(always)]
 pub fn equivalent_stress(s: &Matrix2<f64>, nu: f64, plane: Plane) -> f64 {
-    let (sx, sy, t) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
-    let sz = out_of_plane_stress(sx, sy, nu, plane);
-    (0.5 * ((sx - sy).powi(2) + (sy - sz).powi(2) + (sz - sx).powi(2)) + 3.0 * t * t).sqrt()
+    <Dim<2> as Dimension<2>>::equivalent_stress(s, nu, plane)
 }
 
 /// Linear hardening (4.15): F_eff = f_y + (f_ult − f_y)·ε_eff/ε_ult.

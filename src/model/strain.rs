@@ -10,53 +10,29 @@
 //! neither start nor open at free surfaces; the fit reads a homogeneous strain exactly with
 //! any three independent bond directions. A particle with fewer independent directions gets
 //! the minimum-norm fit (pseudo-inverse).
+//!
+//! The functions here are the 2D instances of `model::dimension` (which also gives 3D).
 
 use crate::scene::Plane;
-use nalgebra::{Matrix2, Matrix3, SMatrix, Vector2};
+use nalgebra::{Matrix2, Vector2};
 
-use super::micro_modulus::strain_projector;
+use super::dimension::{Dim, Dimension};
 
 /// Rows of the least-squares projector P_i (3×K): ε = [εxx, εyy, γxy] = P_i·S.
+/// (`<Dim<2> as Dimension<2>>::StrainFit<K>`.)
 pub type StrainFit<const K: usize> = [[f64; K]; 3];
 
 /// The projector of a particle whose slot k holds a bond of unit direction `dirs[k]`
-/// (`None` where the slot is empty).
+/// (`None` where the slot is empty). 2D wrapper of [`Dimension::strain_fit`].
 pub fn strain_fit<const K: usize>(dirs: &[Option<Vector2<f64>>; K]) -> StrainFit<K> {
-    let mut n = SMatrix::<f64, K, 3>::zeros();
-    for (k, d) in dirs.iter().enumerate() {
-        if let Some(d) = d {
-            let v = strain_projector(d);
-            for c in 0..3 {
-                n[(k, c)] = v[c];
-            }
-        }
-    }
-    let ntn: Matrix3<f64> = n.transpose() * n;
-    let pinv = ntn
-        .pseudo_inverse(1e-10 * ntn.norm().max(f64::MIN_POSITIVE))
-        .unwrap_or_else(|_| Matrix3::zeros());
-    let p = pinv * n.transpose();
-    let mut out = [[0.0; K]; 3];
-    for (c, row) in out.iter_mut().enumerate() {
-        for (k, x) in row.iter_mut().enumerate() {
-            *x = p[(c, k)];
-        }
-    }
-    out
+    <Dim<2> as Dimension<2>>::strain_fit(dirs)
 }
 
-/// The strain tensor (tensor shear) of stretches `s` through projector `p`.
+/// The strain tensor (tensor shear) of stretches `s` through projector `p`. 2D wrapper of
+/// [`Dimension::strain_tensor`].
 #[inline(always)]
 pub fn strain_tensor<const K: usize>(p: &StrainFit<K>, s: &[f64; K]) -> Matrix2<f64> {
-    let mut e = [0.0; 3];
-    for c in 0..3 {
-        let mut acc = 0.0;
-        for k in 0..K {
-            acc += p[c][k] * s[k];
-        }
-        e[c] = acc;
-    }
-    Matrix2::new(e[0], 0.5 * e[2], 0.5 * e[2], e[1])
+    <Dim<2> as Dimension<2>>::strain_tensor(p, s)
 }
 
 /// Principal values p1 ≥ p2 of a symmetric 2×2 tensor in closed form,
@@ -64,30 +40,27 @@ pub fn strain_tensor<const K: usize>(p: &StrainFit<K>, s: &[f64; K]) -> Matrix2<
 /// (`tests::closed_form_principal_values_match_nalgebra`). In the step kernel nalgebra's
 /// iterative solver took 13% of the samples (perf); with this and the 2D von Mises form the
 /// concrete kernel went from 6.47 to 6.76 M particle-steps/s (benchmarks/RESULTS.md).
+/// 2D wrapper of [`Dimension::principal_values`].
 #[inline(always)]
 pub fn principal_values(t: &Matrix2<f64>) -> (f64, f64) {
-    let (a, b, c) = (t[(0, 0)], t[(0, 1)], t[(1, 1)]);
-    let m = 0.5 * (a + c);
-    let r = (0.25 * (a - c) * (a - c) + b * b).sqrt();
-    (m + r, m - r)
+    let [p1, p2] = <Dim<2> as Dimension<2>>::principal_values(t);
+    (p1, p2)
 }
 
 /// Principal strains ε1 ≥ ε2 in the plane and the out-of-plane ε3: 0 in plane strain,
-/// −ν/(1−ν)·(ε1+ε2) in plane stress (σ3 = 0, elastic).
+/// −ν/(1−ν)·(ε1+ε2) in plane stress (σ3 = 0, elastic). 2D wrapper of
+/// [`Dimension::principal_strains`].
 #[inline]
 pub fn principal_strains(e: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64, f64) {
-    let (e1, e2) = principal_values(e);
-    let e3 = match plane {
-        Plane::Strain => 0.0,
-        Plane::Stress => -nu / (1.0 - nu) * (e1 + e2),
-    };
-    (e1, e2, e3)
+    <Dim<2> as Dimension<2>>::principal_strains(e, nu, plane)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::micro_modulus::{elasticity_matrix, hexagonal, stiffness_basis};
+    use crate::model::micro_modulus::{
+        elasticity_matrix, hexagonal, stiffness_basis, strain_projector,
+    };
     use nalgebra::Vector3;
 
     fn hex_dirs(rot: f64, missing: &[usize]) -> [Option<Vector2<f64>>; 6] {

@@ -1,31 +1,40 @@
-//! Particle stress (MODEL.md §7, (3.18)): σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(n_ij ⊗ n_ij).
+//! Particle stress (MODEL.md §7, (3.18)): σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(n_ij ⊗ n_ij),
+//! in any dimension D (2 by default).
 
-use nalgebra::{Matrix2, Vector2};
+use super::dimension::{Dim, Dimension};
+use nalgebra::{Matrix2, SMatrix, SVector};
 
-/// Accumulates the stress of one particle bond by bond.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct StressSum(pub Matrix2<f64>);
+/// Accumulates the stress (3.18) of one particle bond by bond, in D dimensions.
+#[derive(Clone, Copy, Debug)]
+pub struct StressSum<const D: usize = 2>(pub SMatrix<f64, D, D>);
 
-impl StressSum {
+impl<const D: usize> Default for StressSum<D> {
+    fn default() -> Self {
+        StressSum(SMatrix::zeros())
+    }
+}
+
+impl<const D: usize> StressSum<D> {
     /// Add a bond of direction `n` (unit), reference length `l0` and force state `fs`.
     #[inline]
-    pub fn add(&mut self, n: &Vector2<f64>, l0: f64, fs: f64) {
+    pub fn add(&mut self, n: &SVector<f64, D>, l0: f64, fs: f64) {
         self.0 += n * n.transpose() * (l0 * fs);
     }
 
     /// The stress tensor (Pa) of a particle of volume ΔV.
-    pub fn finish(self, volume: f64) -> Matrix2<f64> {
+    pub fn finish(self, volume: f64) -> SMatrix<f64, D, D> {
         self.0 / (2.0 * volume)
     }
 }
 
-/// Von Mises equivalent stress of a plane stress state (σ3 = 0).
+/// Von Mises equivalent stress of a plane stress state (σ3 = 0). 2D wrapper of
+/// [`Dimension::von_mises`].
 pub fn von_mises(s: &Matrix2<f64>) -> f64 {
-    let (sx, sy, txy) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
-    (sx * sx - sx * sy + sy * sy + 3.0 * txy * txy).sqrt()
+    <Dim<2> as Dimension<2>>::von_mises(s)
 }
 
-/// Largest principal stress (nalgebra's symmetric eigen solver).
+/// Largest principal stress (nalgebra's symmetric eigen solver). 2D wrapper of
+/// [`Dimension::max_principal`].
 pub fn max_principal(s: &Matrix2<f64>) -> f64 {
-    s.symmetric_eigenvalues().max()
+    <Dim<2> as Dimension<2>>::max_principal(s)
 }

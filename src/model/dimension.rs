@@ -1,0 +1,1483 @@
+//! Dimension as a type: the constitutive tensors of the model in 2D and 3D from one source.
+//!
+//! [`Dim<D>`] is a marker for the spatial dimension; [`Dimension<D>`] (implemented for
+//! `Dim<2>` and `Dim<3>`) is what the rest of the model and the solver ask of a dimension:
+//!
+//! - the Voigt strain projector v(n) of a unit bond direction, S = n·ε·n = v·ε (§3, (3.20)),
+//!   and the Voigt ↔ tensor conversions;
+//! - the least-squares strain fit of a particle from its bond stretches (§7 and §13;
+//!   see `model::strain`): the projector P_i = N_i⁺ and ε = P_i·S;
+//! - principal values (closed form), principal strains with the out-of-plane component,
+//!   the extreme principal stresses the concrete criteria use (§8), and the von Mises
+//!   equivalent stress of the yield criterion (§9, (3.39)–(3.43) with the erratum);
+//! - the isotropic elasticity matrix D, σ = D·ε, and the stiffness basis and least-squares
+//!   micro-modulus fit D ≈ a·A + b·B of (3.20).
+//!
+//! The stress accumulation (3.18) σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(n_ij ⊗ n_ij) is the
+//! generic [`crate::model::stress::StressSum<D>`].
+//!
+//! **Layout.** Voigt vectors have V = 3 components in 2D, [xx, yy, xy], and V = 6 in 3D,
+//! [xx, yy, zz, yz, xz, xy]. Strains carry engineering shear (γ = 2ε), stresses the tensor
+//! shear. The projector is v = [nx², ny², nx·ny] in 2D and
+//! [nx², ny², nz², ny·nz, nx·nz, nx·ny] in 3D. Only this layout ([`Layout<D, V>`]: [`Voigt3`] in 2D, [`Voigt6`] in 3D), the
+//! elasticity matrix and the principal-value formulas differ between the dimensions; the
+//! strain fit, σ = D·ε, the stiffness basis and the least-squares fit are written once over
+//! `Layout<D, V>` (the free functions below) and both dimensions instantiate them.
+//!
+//! **Plane stress / plane strain.** A 2D model is a slice of a 3D body: the methods that
+//! need the out-of-plane component take the Poisson ratio ν and the [`Plane`] at run time,
+//! exactly as the 2D functions did (plane stress: σ_zz = 0, ε_zz = −ν/(1−ν)·(ε1+ε2);
+//! plane strain: ε_zz = 0, σ_zz = ν·(σ1+σ2)). In 3D there is no out-of-plane component and
+//! these arguments are ignored, so the solver calls the same methods in both dimensions
+//! (pass the scene's plane, or any value, in 3D).
+//!
+//! **Bit-identical 2D.** `Dim<2>` performs exactly the floating-point operations of the 2D
+//! functions it replaces (`strain::strain_fit`, `strain::strain_tensor`,
+//! `strain::principal_values`, `strain::principal_strains`, `plasticity::equivalent_stress`,
+//! `stress::von_mises`, `micro_modulus::elasticity_matrix`, `micro_modulus::stiffness_basis`,
+//! `micro_modulus::fit`), which are now thin wrappers over it; `tests` compares every one
+//! with a verbatim copy of the old code on random inputs with `==`.
+//!
+//! **3D principal values** are in closed form (trigonometric method on the deviator with
+//! the discriminant as a sum of squares, [`principal_values_3`]), accurate to round-off of
+//! the tensor's norm also at repeated and nearly repeated eigenvalues.
+
+use crate::scene::Plane;
+use nalgebra::allocator::Allocator;
+use nalgebra::{
+    ArrayStorage, Const, DefaultAllocator, DimDiff, DimMin, DimSub, Matrix2, Matrix3, Matrix6,
+    SMatrix, SVector, Vector3, Vector6, U1,
+};
+use std::fmt::Debug;
+
+/// A position or bond direction in D dimensions.
+pub type Vector<const D: usize> = SVector<f64, D>;
+/// A symmetric second-order tensor (stress, strain) in D dimensions.
+pub type Tensor<const D: usize> = SMatrix<f64, D, D>;
+
+/// Marker type of the spatial dimension D (2 or 3).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Dim<const D: usize>;
+
+/// The 2D Voigt layout [xx, yy, xy].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Voigt3;
+
+/// The 3D Voigt layout [xx, yy, zz, yz, xz, xy].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Voigt6;
+
+/// The Voigt layout of a dimension D with V components: the only per-dimension ingredient of
+/// the generic strain fit, σ = D·ε and the stiffness fit. Implemented by [`Voigt3`] (2D) and
+/// [`Voigt6`] (3D); [`Dimension`] re-exposes it per dimension.
+pub trait Layout<const D: usize, const V: usize> {
+    /// v(n) of a unit bond direction n: its stretch under strain ε is S = v·ε (Voigt strain,
+    /// engineering shear); its stress contribution (3.18) is ∝ v (Voigt stress).
+    fn projector(n: &Vector<D>) -> SVector<f64, V>;
+    /// Strain tensor → Voigt with engineering shear γ = 2ε_ij.
+    fn strain_to_voigt(e: &Tensor<D>) -> SVector<f64, V>;
+    /// Voigt strain (engineering shear) → strain tensor.
+    fn voigt_to_strain(v: &SVector<f64, V>) -> Tensor<D>;
+    /// Stress tensor → Voigt (tensor shear).
+    fn stress_to_voigt(s: &Tensor<D>) -> SVector<f64, V>;
+    /// Voigt stress → stress tensor.
+    fn voigt_to_stress(v: &SVector<f64, V>) -> Tensor<D>;
+}
+
+/// What the model asks of a spatial dimension D. Implemented for [`Dim<2>`] and [`Dim<3>`];
+/// code generic over `const D: usize` bounds `Dim<D>: Dimension<D>`.
+///
+/// Methods taking `nu` and `plane` need them only for the 2D out-of-plane component; 3D
+/// ignores both.
+pub trait Dimension<const D: usize>: Copy + Default + Debug + Send + Sync + 'static {
+    /// Number of Voigt components: 3 in 2D, 6 in 3D.
+    const VOIGT: usize;
+    /// A Voigt vector (`Vector3` in 2D, `Vector6` in 3D).
+    type Voigt: Copy + Debug + PartialEq + Send + Sync + 'static;
+    /// A V×V matrix in Voigt notation: elasticity D, stiffness bases A, B, C.
+    type Stiffness: Copy + Debug + PartialEq + Send + Sync + 'static;
+    /// Rows of a particle's least-squares strain projector for K slots, V×K
+    /// (`[[f64; K]; V]`).
+    type StrainFit<const K: usize>: Copy + Debug + PartialEq + Send + Sync + 'static;
+
+    /// v(n), see [`Layout::projector`].
+    fn projector(n: &Vector<D>) -> Self::Voigt;
+    /// See [`Layout::strain_to_voigt`].
+    fn strain_to_voigt(e: &Tensor<D>) -> Self::Voigt;
+    /// See [`Layout::voigt_to_strain`].
+    fn voigt_to_strain(v: &Self::Voigt) -> Tensor<D>;
+    /// See [`Layout::stress_to_voigt`].
+    fn stress_to_voigt(s: &Tensor<D>) -> Self::Voigt;
+    /// See [`Layout::voigt_to_stress`].
+    fn voigt_to_stress(v: &Self::Voigt) -> Tensor<D>;
+
+    /// The least-squares strain projector of a particle whose slot k holds a bond of unit
+    /// direction `dirs[k]` (`None` where empty): minimum-norm pseudo-inverse of N (rows v_k).
+    fn strain_fit<const K: usize>(dirs: &[Option<Vector<D>>; K]) -> Self::StrainFit<K>;
+    /// The strain tensor ε = P·S of stretches `s` through projector `p`.
+    fn strain_tensor<const K: usize>(p: &Self::StrainFit<K>, s: &[f64; K]) -> Tensor<D>;
+
+    /// Principal values of a symmetric tensor in closed form, sorted descending.
+    fn principal_values(t: &Tensor<D>) -> [f64; D];
+    /// Principal strains (ε1, ε2, ε3). 2D: ε1 ≥ ε2 in the plane and the out-of-plane ε3
+    /// (0 in plane strain, −ν/(1−ν)·(ε1+ε2) in plane stress), not sorted against ε1, ε2.
+    /// 3D: the three principal values, descending.
+    fn principal_strains(e: &Tensor<D>, nu: f64, plane: Plane) -> (f64, f64, f64);
+    /// (σ_max, σ_min): the largest and smallest principal stress including, in 2D, the
+    /// out-of-plane σ_zz (`plasticity::out_of_plane_stress`) — the pair the concrete
+    /// criteria take (§8, `damage::initiates`).
+    fn principal_stress_extremes(s: &Tensor<D>, nu: f64, plane: Plane) -> (f64, f64);
+    /// Von Mises equivalent stress √(3/2)·‖σ_dev‖ ((3.39), (3.40)); in 2D with σ_zz from the
+    /// plane (plane stress 0, plane strain ν·(σxx+σyy)).
+    fn equivalent_stress(s: &Tensor<D>, nu: f64, plane: Plane) -> f64;
+    /// Von Mises stress of the tensor as given (2D: σ_zz = 0, the plane stress form).
+    fn von_mises(s: &Tensor<D>) -> f64;
+    /// Largest principal value (nalgebra's symmetric eigen solver, as the output maps use).
+    fn max_principal(s: &Tensor<D>) -> f64;
+
+    /// Isotropic elasticity matrix D (Voigt, engineering shear strain); 2D by plane.
+    fn elasticity(e: f64, nu: f64, plane: Plane) -> Self::Stiffness;
+    /// σ = D·ε as tensors (`d` any Voigt stiffness, e.g. a scaled [`Dimension::elasticity`]).
+    fn stress_of_strain(d: &Self::Stiffness, eps: &Tensor<D>) -> Tensor<D>;
+
+    /// The bases A = Σ_j w_j v_j v_jᵀ and B = (Σ_j w_j v_j)(Σ_k v_k)ᵀ, w_j = L0,j/(2ΔV), of a
+    /// particle with bonds (unit direction, reference length) and volume ΔV: its stiffness
+    /// under F_s,ij = a·S_ij + b·Σ_m S_im is a·A + b·B (3.20). (For FCC second neighbours,
+    /// the c-basis C is A of the second-neighbour bonds alone; see `micro_modulus::fcc_basis`.)
+    fn stiffness_basis(
+        bonds: &[(Vector<D>, f64)],
+        volume: f64,
+    ) -> (Self::Stiffness, Self::Stiffness);
+    /// Least-squares a, b with D ≈ a·A + b·B (3.20); `None` when A is rank deficient or
+    /// a ≤ 0 or not finite.
+    fn fit(
+        bonds: &[(Vector<D>, f64)],
+        volume: f64,
+        d: &Self::Stiffness,
+    ) -> Option<crate::model::micro_modulus::Fit>;
+}
+
+// ---------------------------------------------------------------------------------------
+// Generic code, written once over the Voigt layout.
+// ---------------------------------------------------------------------------------------
+
+/// The least-squares strain projector P = (NᵀN)⁺·Nᵀ (V×K) of a particle whose slot k holds
+/// a bond of unit direction `dirs[k]`; N's rows are v(n_k) (zero for empty slots).
+pub fn strain_fit<const D: usize, const V: usize, const K: usize, L: Layout<D, V>>(
+    dirs: &[Option<Vector<D>>; K],
+) -> [[f64; K]; V]
+where
+    Const<V>: DimMin<Const<V>, Output = Const<V>> + DimSub<U1>,
+    DefaultAllocator: Allocator<DimDiff<Const<V>, U1>>,
+{
+    let mut n = SMatrix::<f64, K, V>::from_array_storage(ArrayStorage([[0.0; K]; V]));
+    for (k, d) in dirs.iter().enumerate() {
+        if let Some(d) = d {
+            let v = L::projector(d);
+            for c in 0..V {
+                n[(k, c)] = v[c];
+            }
+        }
+    }
+    let ntn: SMatrix<f64, V, V> = n.transpose() * n;
+    let pinv = pseudo_inverse(ntn);
+    let p = pinv * n.transpose();
+    let mut out = [[0.0; K]; V];
+    for (c, row) in out.iter_mut().enumerate() {
+        for (k, x) in row.iter_mut().enumerate() {
+            *x = p[(c, k)];
+        }
+    }
+    out
+}
+
+/// Pseudo-inverse of NᵀN with singular values below 1e-10·‖NᵀN‖ dropped (zero if the SVD
+/// fails).
+fn pseudo_inverse<const V: usize>(ntn: SMatrix<f64, V, V>) -> SMatrix<f64, V, V>
+where
+    Const<V>: DimMin<Const<V>, Output = Const<V>> + DimSub<U1>,
+    DefaultAllocator: Allocator<DimDiff<Const<V>, U1>>,
+{
+    match ntn.pseudo_inverse(1e-10 * ntn.norm().max(f64::MIN_POSITIVE)) {
+        Ok(p) => p,
+        Err(_) => SMatrix::from_array_storage(ArrayStorage([[0.0; V]; V])),
+    }
+}
+
+/// The strain tensor of stretches `s` through projector `p`: ε_voigt = P·S.
+#[inline(always)]
+pub fn strain_tensor<const D: usize, const V: usize, const K: usize, L: Layout<D, V>>(
+    p: &[[f64; K]; V],
+    s: &[f64; K],
+) -> Tensor<D> {
+    let mut e = [0.0; V];
+    for c in 0..V {
+        let mut acc = 0.0;
+        for k in 0..K {
+            acc += p[c][k] * s[k];
+        }
+        e[c] = acc;
+    }
+    L::voigt_to_strain(&SVector::<f64, V>::from(e))
+}
+
+/// σ = D·ε as tensors.
+#[inline(always)]
+pub fn stress_of_strain<const D: usize, const V: usize, L: Layout<D, V>>(
+    d: &SMatrix<f64, V, V>,
+    eps: &Tensor<D>,
+) -> Tensor<D> {
+    let sv = d * L::strain_to_voigt(eps);
+    L::voigt_to_stress(&sv)
+}
+
+/// The bases A and B of bonds (unit direction, reference length) of a particle of volume ΔV
+/// (see [`Dimension::stiffness_basis`]).
+pub fn stiffness_basis<const D: usize, const V: usize, L: Layout<D, V>>(
+    bonds: &[(Vector<D>, f64)],
+    volume: f64,
+) -> (SMatrix<f64, V, V>, SMatrix<f64, V, V>) {
+    let mut a = SMatrix::<f64, V, V>::zeros();
+    let mut mv = SVector::<f64, V>::zeros();
+    let mut nv = SVector::<f64, V>::zeros();
+    for (n, l0) in bonds {
+        let v = L::projector(n);
+        let w = l0 / (2.0 * volume);
+        a += v * v.transpose() * w;
+        mv += v * w;
+        nv += v;
+    }
+    (a, mv * nv.transpose())
+}
+
+/// Least-squares coefficients x with d ≈ Σ_p x_p·basis[p] (Frobenius norm) and the relative
+/// residual ‖Σ_p x_p·basis[p] − d‖/‖d‖. `None` when basis[0] (the a-basis A, which must
+/// resist every strain) is rank deficient (|det A| ≤ 1e-12·‖A‖^V), the Gram matrix is
+/// singular, x_0 ≤ 0, any x_p is not finite, or `accept(x)` refuses.
+pub fn least_squares<const V: usize, const P: usize>(
+    basis: &[SMatrix<f64, V, V>; P],
+    d: &SMatrix<f64, V, V>,
+    accept: impl Fn(&[f64; P]) -> bool,
+) -> Option<([f64; P], f64)>
+where
+    Const<V>: DimMin<Const<V>, Output = Const<V>>,
+{
+    let dot = |x: &SMatrix<f64, V, V>, y: &SMatrix<f64, V, V>| x.component_mul(y).sum();
+    let g = SMatrix::<f64, P, P>::from_fn(|i, j| dot(&basis[i], &basis[j]));
+    let r = SVector::<f64, P>::from_fn(|i, _| dot(&basis[i], d));
+    let a_m = &basis[0];
+    if a_m.determinant().abs() <= 1e-12 * a_m.norm().powi(V as i32) {
+        return None;
+    }
+    let sol = g.try_inverse()? * r;
+    let x: [f64; P] = sol.into();
+    if !(x[0] > 0.0 && x.iter().all(|v| v.is_finite()) && accept(&x)) {
+        return None;
+    }
+    let mut model = basis[0] * x[0];
+    for p in 1..P {
+        model += basis[p] * x[p];
+    }
+    let residual = (model - d).norm() / d.norm();
+    Some((x, residual))
+}
+
+// ---------------------------------------------------------------------------------------
+// 2D
+// ---------------------------------------------------------------------------------------
+
+impl Layout<2, 3> for Voigt3 {
+    #[inline(always)]
+    fn projector(n: &Vector<2>) -> Vector3<f64> {
+        Vector3::new(n.x * n.x, n.y * n.y, n.x * n.y)
+    }
+    #[inline(always)]
+    fn strain_to_voigt(e: &Matrix2<f64>) -> Vector3<f64> {
+        Vector3::new(e[(0, 0)], e[(1, 1)], 2.0 * e[(0, 1)])
+    }
+    #[inline(always)]
+    fn voigt_to_strain(e: &Vector3<f64>) -> Matrix2<f64> {
+        Matrix2::new(e[0], 0.5 * e[2], 0.5 * e[2], e[1])
+    }
+    #[inline(always)]
+    fn stress_to_voigt(s: &Matrix2<f64>) -> Vector3<f64> {
+        Vector3::new(s[(0, 0)], s[(1, 1)], s[(0, 1)])
+    }
+    #[inline(always)]
+    fn voigt_to_stress(v: &Vector3<f64>) -> Matrix2<f64> {
+        Matrix2::new(v[0], v[2], v[2], v[1])
+    }
+}
+
+/// Principal values p1 ≥ p2 of a symmetric 2×2 tensor, (a+c)/2 ± √(((a−c)/2)² + b²).
+#[inline(always)]
+fn principal_values_2(t: &Matrix2<f64>) -> (f64, f64) {
+    let (a, b, c) = (t[(0, 0)], t[(0, 1)], t[(1, 1)]);
+    let m = 0.5 * (a + c);
+    let r = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+    (m + r, m - r)
+}
+
+/// Out-of-plane stress σ_zz of a 2D particle: 0 in plane stress, ν·(σxx + σyy) in plane
+/// strain (the sum of the in-plane normal stresses, equally of the principal ones).
+#[inline(always)]
+pub fn out_of_plane_stress(sxx: f64, syy: f64, nu: f64, plane: Plane) -> f64 {
+    match plane {
+        Plane::Stress => 0.0,
+        Plane::Strain => nu * (sxx + syy),
+    }
+}
+
+impl Dimension<2> for Dim<2> {
+    const VOIGT: usize = 3;
+    type Voigt = Vector3<f64>;
+    type Stiffness = Matrix3<f64>;
+    type StrainFit<const K: usize> = [[f64; K]; 3];
+
+    #[inline(always)]
+    fn projector(n: &Vector<2>) -> Vector3<f64> {
+        Voigt3::projector(n)
+    }
+    #[inline(always)]
+    fn strain_to_voigt(e: &Matrix2<f64>) -> Vector3<f64> {
+        Voigt3::strain_to_voigt(e)
+    }
+    #[inline(always)]
+    fn voigt_to_strain(v: &Vector3<f64>) -> Matrix2<f64> {
+        Voigt3::voigt_to_strain(v)
+    }
+    #[inline(always)]
+    fn stress_to_voigt(s: &Matrix2<f64>) -> Vector3<f64> {
+        Voigt3::stress_to_voigt(s)
+    }
+    #[inline(always)]
+    fn voigt_to_stress(v: &Vector3<f64>) -> Matrix2<f64> {
+        Voigt3::voigt_to_stress(v)
+    }
+
+    fn strain_fit<const K: usize>(dirs: &[Option<Vector<2>>; K]) -> [[f64; K]; 3] {
+        strain_fit::<2, 3, K, Voigt3>(dirs)
+    }
+    #[inline(always)]
+    fn strain_tensor<const K: usize>(p: &[[f64; K]; 3], s: &[f64; K]) -> Matrix2<f64> {
+        strain_tensor::<2, 3, K, Voigt3>(p, s)
+    }
+
+    #[inline(always)]
+    fn principal_values(t: &Matrix2<f64>) -> [f64; 2] {
+        let (p1, p2) = principal_values_2(t);
+        [p1, p2]
+    }
+    #[inline]
+    fn principal_strains(e: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64, f64) {
+        let (e1, e2) = principal_values_2(e);
+        let e3 = match plane {
+            Plane::Strain => 0.0,
+            Plane::Stress => -nu / (1.0 - nu) * (e1 + e2),
+        };
+        (e1, e2, e3)
+    }
+    #[inline(always)]
+    fn principal_stress_extremes(s: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64) {
+        let (s1, s2) = principal_values_2(s);
+        let s33 = out_of_plane_stress(s1, s2, nu, plane);
+        (s1.max(s33), s2.min(s33))
+    }
+    #[inline(always)]
+    fn equivalent_stress(s: &Matrix2<f64>, nu: f64, plane: Plane) -> f64 {
+        let (sx, sy, t) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
+        let sz = out_of_plane_stress(sx, sy, nu, plane);
+        (0.5 * ((sx - sy).powi(2) + (sy - sz).powi(2) + (sz - sx).powi(2)) + 3.0 * t * t).sqrt()
+    }
+    #[inline]
+    fn von_mises(s: &Matrix2<f64>) -> f64 {
+        let (sx, sy, txy) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
+        (sx * sx - sx * sy + sy * sy + 3.0 * txy * txy).sqrt()
+    }
+    fn max_principal(s: &Matrix2<f64>) -> f64 {
+        s.symmetric_eigenvalues().max()
+    }
+
+    fn elasticity(e: f64, nu: f64, plane: Plane) -> Matrix3<f64> {
+        match plane {
+            Plane::Stress => {
+                let c = e / (1.0 - nu * nu);
+                Matrix3::new(
+                    c,
+                    c * nu,
+                    0.0,
+                    c * nu,
+                    c,
+                    0.0,
+                    0.0,
+                    0.0,
+                    c * (1.0 - nu) / 2.0,
+                )
+            }
+            Plane::Strain => {
+                let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+                Matrix3::new(
+                    c * (1.0 - nu),
+                    c * nu,
+                    0.0,
+                    c * nu,
+                    c * (1.0 - nu),
+                    0.0,
+                    0.0,
+                    0.0,
+                    c * (1.0 - 2.0 * nu) / 2.0,
+                )
+            }
+        }
+    }
+    #[inline(always)]
+    fn stress_of_strain(d: &Matrix3<f64>, eps: &Matrix2<f64>) -> Matrix2<f64> {
+        stress_of_strain::<2, 3, Voigt3>(d, eps)
+    }
+
+    fn stiffness_basis(bonds: &[(Vector<2>, f64)], volume: f64) -> (Matrix3<f64>, Matrix3<f64>) {
+        stiffness_basis::<2, 3, Voigt3>(bonds, volume)
+    }
+    fn fit(
+        bonds: &[(Vector<2>, f64)],
+        volume: f64,
+        d: &Matrix3<f64>,
+    ) -> Option<crate::model::micro_modulus::Fit> {
+        fit_ab::<2, 3, Voigt3>(bonds, volume, d)
+    }
+}
+
+/// The (a, b) fit of either dimension.
+fn fit_ab<const D: usize, const V: usize, L: Layout<D, V>>(
+    bonds: &[(Vector<D>, f64)],
+    volume: f64,
+    d: &SMatrix<f64, V, V>,
+) -> Option<crate::model::micro_modulus::Fit>
+where
+    Const<V>: DimMin<Const<V>, Output = Const<V>>,
+{
+    let (a_m, b_m) = stiffness_basis::<D, V, L>(bonds, volume);
+    let ([a, b], residual) = least_squares(&[a_m, b_m], d, |_| true)?;
+    Some(crate::model::micro_modulus::Fit {
+        moduli: crate::model::micro_modulus::MicroModuli { a, b },
+        residual,
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// 3D
+// ---------------------------------------------------------------------------------------
+
+impl Layout<3, 6> for Voigt6 {
+    #[inline(always)]
+    fn projector(n: &Vector<3>) -> Vector6<f64> {
+        Vector6::new(
+            n.x * n.x,
+            n.y * n.y,
+            n.z * n.z,
+            n.y * n.z,
+            n.x * n.z,
+            n.x * n.y,
+        )
+    }
+    #[inline(always)]
+    fn strain_to_voigt(e: &Matrix3<f64>) -> Vector6<f64> {
+        Vector6::new(
+            e[(0, 0)],
+            e[(1, 1)],
+            e[(2, 2)],
+            2.0 * e[(1, 2)],
+            2.0 * e[(0, 2)],
+            2.0 * e[(0, 1)],
+        )
+    }
+    #[inline(always)]
+    fn voigt_to_strain(e: &Vector6<f64>) -> Matrix3<f64> {
+        let (yz, xz, xy) = (0.5 * e[3], 0.5 * e[4], 0.5 * e[5]);
+        Matrix3::new(e[0], xy, xz, xy, e[1], yz, xz, yz, e[2])
+    }
+    #[inline(always)]
+    fn stress_to_voigt(s: &Matrix3<f64>) -> Vector6<f64> {
+        Vector6::new(
+            s[(0, 0)],
+            s[(1, 1)],
+            s[(2, 2)],
+            s[(1, 2)],
+            s[(0, 2)],
+            s[(0, 1)],
+        )
+    }
+    #[inline(always)]
+    fn voigt_to_stress(v: &Vector6<f64>) -> Matrix3<f64> {
+        Matrix3::new(v[0], v[5], v[4], v[5], v[1], v[3], v[4], v[3], v[2])
+    }
+}
+
+/// Principal values of a symmetric 3×3 tensor in closed form, sorted descending. Only the
+/// lower triangle is read (as nalgebra's symmetric eigen solver).
+///
+/// Trigonometric method on the deviator s = t − (tr t/3)·I, scaled to order one: the
+/// eigenvalues of s are 2√(J2/3)·cos(θ − 2πk/3), with 3θ = atan2(√Δ, 3√3·J3),
+/// J2 = ½ tr s², J3 = det s and Δ = 4J2³ − 27J3² = Π_{i<j}(λ_i − λ_j)² the discriminant.
+/// Δ is not formed by that difference (which cancels catastrophically at nearly repeated
+/// eigenvalues, where acos-based formulas lose half the digits) but as the Gram determinant
+/// of (I, s, s²): Δ = 3·(‖s‖²‖t‖² − ⟨s, t⟩²) with t = s² − (tr s²/3)·I, and the bracket by
+/// Lagrange's identity as a sum of squares of 2×2 minors, each computed with an absolute
+/// error of round-off times ‖s‖³. So the angle, and the eigenvalues, are accurate to a few
+/// ulps of ‖t‖ whatever the eigenvalue gaps (`tests::principal_values_3_match_nalgebra`).
+pub fn principal_values_3(t: &Matrix3<f64>) -> [f64; 3] {
+    let m = (t[(0, 0)] + t[(1, 1)] + t[(2, 2)]) / 3.0;
+    let (a, b, c) = (t[(0, 0)] - m, t[(1, 1)] - m, t[(2, 2)] - m);
+    let (xy, yz, xz) = (t[(1, 0)], t[(2, 1)], t[(2, 0)]);
+    // Scale (a sum keeps NaN); zero deviator: three equal values.
+    let scale = a.abs() + b.abs() + c.abs() + xy.abs() + yz.abs() + xz.abs();
+    if scale == 0.0 {
+        return [m, m, m];
+    }
+    let k = 1.0 / scale;
+    let (a, b, c, xy, yz, xz) = (a * k, b * k, c * k, xy * k, yz * k, xz * k);
+    // s² (symmetric), its trace and the deviator t of s².
+    let q00 = a * a + xy * xy + xz * xz;
+    let q11 = xy * xy + b * b + yz * yz;
+    let q22 = xz * xz + yz * yz + c * c;
+    let q01 = a * xy + xy * b + xz * yz;
+    let q12 = xy * xz + b * yz + yz * c;
+    let q02 = a * xz + xy * yz + xz * c;
+    let tr2 = q00 + q11 + q22; // = 2·J2
+    let j2 = 0.5 * tr2;
+    let t3 = tr2 / 3.0;
+    let (t00, t11, t22) = (q00 - t3, q11 - t3, q22 - t3);
+    // J3 = det s.
+    let j3 = a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz);
+    // ‖s‖²‖t‖² − ⟨s,t⟩² in orthonormal coordinates (diagonal, √2·off-diagonal).
+    let sd = [a, b, c];
+    let td = [t00, t11, t22];
+    let so = [yz, xz, xy];
+    let to = [q12, q02, q01];
+    let mut gram = 0.0;
+    for i in 0..3 {
+        for j in (i + 1)..3 {
+            let x = sd[i] * td[j] - sd[j] * td[i];
+            gram += x * x;
+            let y = so[i] * to[j] - so[j] * to[i];
+            gram += 4.0 * y * y;
+        }
+        for j in 0..3 {
+            let z = sd[i] * to[j] - so[j] * td[i];
+            gram += 2.0 * z * z;
+        }
+    }
+    let disc_sqrt = (3.0 * gram).sqrt();
+    let theta = disc_sqrt.atan2(3.0 * 3f64.sqrt() * j3) / 3.0;
+    let r = 2.0 * (j2 / 3.0).sqrt();
+    let third = 2.0 * std::f64::consts::FRAC_PI_3;
+    let mut p = [
+        r * theta.cos(),
+        r * (theta - third).cos(),
+        r * (theta + third).cos(),
+    ];
+    // Sorted by construction for θ ∈ [0, π/3]; round-off may swap near-equal values.
+    if p[1] > p[0] {
+        p.swap(0, 1);
+    }
+    if p[2] > p[1] {
+        p.swap(1, 2);
+        if p[1] > p[0] {
+            p.swap(0, 1);
+        }
+    }
+    [m + p[0] * scale, m + p[1] * scale, m + p[2] * scale]
+}
+
+impl Dimension<3> for Dim<3> {
+    const VOIGT: usize = 6;
+    type Voigt = Vector6<f64>;
+    type Stiffness = Matrix6<f64>;
+    type StrainFit<const K: usize> = [[f64; K]; 6];
+
+    #[inline(always)]
+    fn projector(n: &Vector<3>) -> Vector6<f64> {
+        Voigt6::projector(n)
+    }
+    #[inline(always)]
+    fn strain_to_voigt(e: &Matrix3<f64>) -> Vector6<f64> {
+        Voigt6::strain_to_voigt(e)
+    }
+    #[inline(always)]
+    fn voigt_to_strain(v: &Vector6<f64>) -> Matrix3<f64> {
+        Voigt6::voigt_to_strain(v)
+    }
+    #[inline(always)]
+    fn stress_to_voigt(s: &Matrix3<f64>) -> Vector6<f64> {
+        Voigt6::stress_to_voigt(s)
+    }
+    #[inline(always)]
+    fn voigt_to_stress(v: &Vector6<f64>) -> Matrix3<f64> {
+        Voigt6::voigt_to_stress(v)
+    }
+
+    fn strain_fit<const K: usize>(dirs: &[Option<Vector<3>>; K]) -> [[f64; K]; 6] {
+        strain_fit::<3, 6, K, Voigt6>(dirs)
+    }
+    #[inline(always)]
+    fn strain_tensor<const K: usize>(p: &[[f64; K]; 6], s: &[f64; K]) -> Matrix3<f64> {
+        strain_tensor::<3, 6, K, Voigt6>(p, s)
+    }
+
+    #[inline]
+    fn principal_values(t: &Matrix3<f64>) -> [f64; 3] {
+        principal_values_3(t)
+    }
+    /// The three principal values; `nu` and `plane` are ignored.
+    #[inline]
+    fn principal_strains(e: &Matrix3<f64>, _nu: f64, _plane: Plane) -> (f64, f64, f64) {
+        let [e1, e2, e3] = principal_values_3(e);
+        (e1, e2, e3)
+    }
+    /// (σ1, σ3); `nu` and `plane` are ignored.
+    #[inline]
+    fn principal_stress_extremes(s: &Matrix3<f64>, _nu: f64, _plane: Plane) -> (f64, f64) {
+        let [s1, _, s3] = principal_values_3(s);
+        (s1, s3)
+    }
+    /// The full von Mises stress; `nu` and `plane` are ignored.
+    #[inline]
+    fn equivalent_stress(s: &Matrix3<f64>, _nu: f64, _plane: Plane) -> f64 {
+        <Self as Dimension<3>>::von_mises(s)
+    }
+    #[inline]
+    fn von_mises(s: &Matrix3<f64>) -> f64 {
+        let (sx, sy, sz) = (s[(0, 0)], s[(1, 1)], s[(2, 2)]);
+        let (yz, xz, xy) = (s[(1, 2)], s[(0, 2)], s[(0, 1)]);
+        (0.5 * ((sx - sy).powi(2) + (sy - sz).powi(2) + (sz - sx).powi(2))
+            + 3.0 * (xy * xy + yz * yz + xz * xz))
+            .sqrt()
+    }
+    fn max_principal(s: &Matrix3<f64>) -> f64 {
+        s.symmetric_eigenvalues().max()
+    }
+
+    /// Isotropic D = λ·(1⊗1) + 2μ·I (engineering shear: μ on the shear diagonal); `plane`
+    /// is ignored.
+    fn elasticity(e: f64, nu: f64, _plane: Plane) -> Matrix6<f64> {
+        let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+        let (d11, d12, d44) = (c * (1.0 - nu), c * nu, c * (1.0 - 2.0 * nu) / 2.0);
+        let mut d = Matrix6::zeros();
+        for i in 0..3 {
+            for j in 0..3 {
+                d[(i, j)] = if i == j { d11 } else { d12 };
+            }
+            d[(i + 3, i + 3)] = d44;
+        }
+        d
+    }
+    #[inline(always)]
+    fn stress_of_strain(d: &Matrix6<f64>, eps: &Matrix3<f64>) -> Matrix3<f64> {
+        stress_of_strain::<3, 6, Voigt6>(d, eps)
+    }
+
+    fn stiffness_basis(bonds: &[(Vector<3>, f64)], volume: f64) -> (Matrix6<f64>, Matrix6<f64>) {
+        stiffness_basis::<3, 6, Voigt6>(bonds, volume)
+    }
+    fn fit(
+        bonds: &[(Vector<3>, f64)],
+        volume: f64,
+        d: &Matrix6<f64>,
+    ) -> Option<crate::model::micro_modulus::Fit> {
+        fit_ab::<3, 6, Voigt6>(bonds, volume, d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::micro_modulus::{self, fcc, fcc_volume, fit_fcc, hexagonal, FccBond};
+    use crate::model::stress::StressSum;
+    use nalgebra::{Quaternion, UnitQuaternion, Vector2};
+    use rand::rngs::ChaCha20Rng;
+    use rand::{Rng, SeedableRng};
+
+    type D2 = Dim<2>;
+    type D3 = Dim<3>;
+
+    /// Verbatim copies of the 2D functions before the refactor, the reference for the
+    /// bit-identity tests.
+    mod reference {
+        use crate::scene::Plane;
+        use nalgebra::{Matrix2, Matrix3, SMatrix, Vector2, Vector3};
+
+        pub fn strain_projector(n: &Vector2<f64>) -> Vector3<f64> {
+            Vector3::new(n.x * n.x, n.y * n.y, n.x * n.y)
+        }
+
+        pub fn strain_fit<const K: usize>(dirs: &[Option<Vector2<f64>>; K]) -> [[f64; K]; 3] {
+            let mut n = SMatrix::<f64, K, 3>::zeros();
+            for (k, d) in dirs.iter().enumerate() {
+                if let Some(d) = d {
+                    let v = strain_projector(d);
+                    for c in 0..3 {
+                        n[(k, c)] = v[c];
+                    }
+                }
+            }
+            let ntn: Matrix3<f64> = n.transpose() * n;
+            let pinv = ntn
+                .pseudo_inverse(1e-10 * ntn.norm().max(f64::MIN_POSITIVE))
+                .unwrap_or_else(|_| Matrix3::zeros());
+            let p = pinv * n.transpose();
+            let mut out = [[0.0; K]; 3];
+            for (c, row) in out.iter_mut().enumerate() {
+                for (k, x) in row.iter_mut().enumerate() {
+                    *x = p[(c, k)];
+                }
+            }
+            out
+        }
+
+        pub fn strain_tensor<const K: usize>(p: &[[f64; K]; 3], s: &[f64; K]) -> Matrix2<f64> {
+            let mut e = [0.0; 3];
+            for c in 0..3 {
+                let mut acc = 0.0;
+                for k in 0..K {
+                    acc += p[c][k] * s[k];
+                }
+                e[c] = acc;
+            }
+            Matrix2::new(e[0], 0.5 * e[2], 0.5 * e[2], e[1])
+        }
+
+        pub fn principal_values(t: &Matrix2<f64>) -> (f64, f64) {
+            let (a, b, c) = (t[(0, 0)], t[(0, 1)], t[(1, 1)]);
+            let m = 0.5 * (a + c);
+            let r = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+            (m + r, m - r)
+        }
+
+        pub fn principal_strains(e: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64, f64) {
+            let (e1, e2) = principal_values(e);
+            let e3 = match plane {
+                Plane::Strain => 0.0,
+                Plane::Stress => -nu / (1.0 - nu) * (e1 + e2),
+            };
+            (e1, e2, e3)
+        }
+
+        pub fn out_of_plane_stress(sxx: f64, syy: f64, nu: f64, plane: Plane) -> f64 {
+            match plane {
+                Plane::Stress => 0.0,
+                Plane::Strain => nu * (sxx + syy),
+            }
+        }
+
+        pub fn equivalent_stress(s: &Matrix2<f64>, nu: f64, plane: Plane) -> f64 {
+            let (sx, sy, t) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
+            let sz = out_of_plane_stress(sx, sy, nu, plane);
+            (0.5 * ((sx - sy).powi(2) + (sy - sz).powi(2) + (sz - sx).powi(2)) + 3.0 * t * t).sqrt()
+        }
+
+        pub fn von_mises(s: &Matrix2<f64>) -> f64 {
+            let (sx, sy, txy) = (s[(0, 0)], s[(1, 1)], s[(0, 1)]);
+            (sx * sx - sx * sy + sy * sy + 3.0 * txy * txy).sqrt()
+        }
+
+        /// The criteria of `solver/concrete.rs` before the refactor.
+        pub fn extremes(s: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64) {
+            let (s1, s2) = principal_values(s);
+            let s33 = out_of_plane_stress(s1, s2, nu, plane);
+            (s1.max(s33), s2.min(s33))
+        }
+
+        /// D·ε of `solver/concrete.rs` before the refactor.
+        pub fn stress_of_strain(d: &Matrix3<f64>, eps_d: &Matrix2<f64>) -> Matrix2<f64> {
+            let sv = d * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
+            Matrix2::new(sv[0], sv[2], sv[2], sv[1])
+        }
+
+        pub fn elasticity_matrix(e: f64, nu: f64, plane: Plane) -> Matrix3<f64> {
+            match plane {
+                Plane::Stress => {
+                    let c = e / (1.0 - nu * nu);
+                    Matrix3::new(
+                        c,
+                        c * nu,
+                        0.0,
+                        c * nu,
+                        c,
+                        0.0,
+                        0.0,
+                        0.0,
+                        c * (1.0 - nu) / 2.0,
+                    )
+                }
+                Plane::Strain => {
+                    let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+                    Matrix3::new(
+                        c * (1.0 - nu),
+                        c * nu,
+                        0.0,
+                        c * nu,
+                        c * (1.0 - nu),
+                        0.0,
+                        0.0,
+                        0.0,
+                        c * (1.0 - 2.0 * nu) / 2.0,
+                    )
+                }
+            }
+        }
+
+        #[derive(Default)]
+        pub struct StressSum(pub Matrix2<f64>);
+        impl StressSum {
+            pub fn add(&mut self, n: &Vector2<f64>, l0: f64, fs: f64) {
+                self.0 += n * n.transpose() * (l0 * fs);
+            }
+            pub fn finish(self, volume: f64) -> Matrix2<f64> {
+                self.0 / (2.0 * volume)
+            }
+        }
+
+        pub fn stiffness_basis(
+            bonds: &[(Vector2<f64>, f64)],
+            volume: f64,
+        ) -> (Matrix3<f64>, Matrix3<f64>) {
+            let mut a = Matrix3::zeros();
+            let mut mv = Vector3::zeros();
+            let mut nv = Vector3::zeros();
+            for (n, l0) in bonds {
+                let v = strain_projector(n);
+                let w = l0 / (2.0 * volume);
+                a += v * v.transpose() * w;
+                mv += v * w;
+                nv += v;
+            }
+            (a, mv * nv.transpose())
+        }
+
+        /// (a, b, residual).
+        pub fn fit(
+            bonds: &[(Vector2<f64>, f64)],
+            volume: f64,
+            d: &Matrix3<f64>,
+        ) -> Option<(f64, f64, f64)> {
+            let (a_m, b_m) = stiffness_basis(bonds, volume);
+            let dot = |x: &Matrix3<f64>, y: &Matrix3<f64>| x.component_mul(y).sum();
+            let g = nalgebra::Matrix2::new(
+                dot(&a_m, &a_m),
+                dot(&a_m, &b_m),
+                dot(&b_m, &a_m),
+                dot(&b_m, &b_m),
+            );
+            let r = Vector2::new(dot(&a_m, d), dot(&b_m, d));
+            if a_m.determinant().abs() <= 1e-12 * a_m.norm().powi(3) {
+                return None;
+            }
+            let sol = g.try_inverse()? * r;
+            let (a, b) = (sol.x, sol.y);
+            if !(a > 0.0 && a.is_finite() && b.is_finite()) {
+                return None;
+            }
+            let residual = (a_m * a + b_m * b - d).norm() / d.norm();
+            Some((a, b, residual))
+        }
+    }
+
+    /// Uniform in [0, 1).
+    fn uni(r: &mut ChaCha20Rng) -> f64 {
+        (r.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// Uniform in [lo, hi).
+    fn range(r: &mut ChaCha20Rng, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * uni(r)
+    }
+
+    /// A scale 10^U(−e, e).
+    fn scale(r: &mut ChaCha20Rng, e: f64) -> f64 {
+        10f64.powf(range(r, -e, e))
+    }
+
+    fn unit2(r: &mut ChaCha20Rng) -> Vector2<f64> {
+        let a = range(r, 0.0, std::f64::consts::TAU);
+        Vector2::new(a.cos(), a.sin())
+    }
+
+    fn unit3(r: &mut ChaCha20Rng) -> Vector3<f64> {
+        loop {
+            let v = Vector3::new(
+                range(r, -1.0, 1.0),
+                range(r, -1.0, 1.0),
+                range(r, -1.0, 1.0),
+            );
+            let n = v.norm();
+            if n > 0.1 && n <= 1.0 {
+                return v / n;
+            }
+        }
+    }
+
+    fn rotation(r: &mut ChaCha20Rng) -> Matrix3<f64> {
+        let q = Quaternion::new(
+            range(r, -1.0, 1.0),
+            range(r, -1.0, 1.0),
+            range(r, -1.0, 1.0),
+            range(r, -1.0, 1.0),
+        );
+        *UnitQuaternion::from_quaternion(q)
+            .to_rotation_matrix()
+            .matrix()
+    }
+
+    fn sym2(r: &mut ChaCha20Rng, s: f64) -> Matrix2<f64> {
+        let (a, b, c) = (range(r, -s, s), range(r, -s, s), range(r, -s, s));
+        Matrix2::new(a, b, b, c)
+    }
+
+    fn plane(r: &mut ChaCha20Rng) -> Plane {
+        if r.next_u64().is_multiple_of(2) {
+            Plane::Stress
+        } else {
+            Plane::Strain
+        }
+    }
+
+    // -- 2D: the generic path is bit-identical to the old code --------------------------
+
+    #[test]
+    fn two_d_strain_fit_and_tensor_are_bit_identical() {
+        let mut r = ChaCha20Rng::seed_from_u64(1);
+        for case in 0..2000 {
+            let mut dirs = [None; 6];
+            let rot = range(&mut r, 0.0, 1.0);
+            for (k, d) in dirs.iter_mut().enumerate() {
+                // hexagonal slots (some missing), or random directions
+                if r.next_u64() % 5 != 0 {
+                    *d = Some(if case % 2 == 0 {
+                        let a = rot + k as f64 * std::f64::consts::PI / 3.0;
+                        Vector2::new(a.cos(), a.sin())
+                    } else {
+                        unit2(&mut r)
+                    });
+                }
+            }
+            let p = <D2 as Dimension<2>>::strain_fit(&dirs);
+            assert_eq!(p, reference::strain_fit(&dirs));
+            assert_eq!(p, crate::model::strain::strain_fit(&dirs));
+            let sc = scale(&mut r, 6.0);
+            let s: [f64; 6] = std::array::from_fn(|_| range(&mut r, -sc, sc));
+            let e = reference::strain_tensor(&p, &s);
+            assert_eq!(<D2 as Dimension<2>>::strain_tensor(&p, &s), e);
+            assert_eq!(crate::model::strain::strain_tensor(&p, &s), e);
+        }
+    }
+
+    #[test]
+    fn two_d_principal_and_equivalent_values_are_bit_identical() {
+        let mut r = ChaCha20Rng::seed_from_u64(2);
+        for case in 0..20000 {
+            let sc = scale(&mut r, 9.0);
+            let mut t = sym2(&mut r, sc);
+            if case % 7 == 0 {
+                t[(0, 1)] = 0.0;
+                t[(1, 0)] = 0.0;
+            }
+            if case % 11 == 0 {
+                t[(1, 1)] = t[(0, 0)];
+            }
+            let nu = range(&mut r, 0.0, 0.49);
+            let pl = plane(&mut r);
+            let (p1, p2) = reference::principal_values(&t);
+            assert_eq!(<D2 as Dimension<2>>::principal_values(&t), [p1, p2]);
+            assert_eq!(crate::model::strain::principal_values(&t), (p1, p2));
+            let ps = reference::principal_strains(&t, nu, pl);
+            assert_eq!(<D2 as Dimension<2>>::principal_strains(&t, nu, pl), ps);
+            assert_eq!(crate::model::strain::principal_strains(&t, nu, pl), ps);
+            assert_eq!(
+                <D2 as Dimension<2>>::principal_stress_extremes(&t, nu, pl),
+                reference::extremes(&t, nu, pl)
+            );
+            let q = reference::equivalent_stress(&t, nu, pl);
+            assert_eq!(<D2 as Dimension<2>>::equivalent_stress(&t, nu, pl), q);
+            assert_eq!(crate::model::plasticity::equivalent_stress(&t, nu, pl), q);
+            let (sx, sy) = (t[(0, 0)], t[(1, 1)]);
+            assert_eq!(
+                crate::model::plasticity::out_of_plane_stress(sx, sy, nu, pl),
+                reference::out_of_plane_stress(sx, sy, nu, pl)
+            );
+            let vm = reference::von_mises(&t);
+            assert_eq!(<D2 as Dimension<2>>::von_mises(&t), vm);
+            assert_eq!(crate::model::stress::von_mises(&t), vm);
+            assert_eq!(
+                crate::model::stress::max_principal(&t),
+                t.symmetric_eigenvalues().max()
+            );
+        }
+    }
+
+    #[test]
+    fn two_d_elasticity_and_stress_are_bit_identical() {
+        let mut r = ChaCha20Rng::seed_from_u64(3);
+        for _ in 0..5000 {
+            let e = range(&mut r, 1e9, 60e9);
+            let nu = range(&mut r, 0.0, 0.49);
+            let pl = plane(&mut r);
+            let d = reference::elasticity_matrix(e, nu, pl);
+            assert_eq!(<D2 as Dimension<2>>::elasticity(e, nu, pl), d);
+            assert_eq!(micro_modulus::elasticity_matrix(e, nu, pl), d);
+            let d = d * range(&mut r, 0.5, 2.0);
+            let sc = scale(&mut r, 4.0);
+            let eps = sym2(&mut r, sc);
+            assert_eq!(
+                <D2 as Dimension<2>>::stress_of_strain(&d, &eps),
+                reference::stress_of_strain(&d, &eps)
+            );
+            // (3.18) bond by bond
+            let vol = range(&mut r, 1e-6, 1e-4);
+            let mut old = reference::StressSum::default();
+            let mut new = StressSum::default();
+            for _ in 0..6 {
+                let (n, l0, fs) = (
+                    unit2(&mut r),
+                    range(&mut r, 1e-3, 1e-2),
+                    range(&mut r, -1e5, 1e5),
+                );
+                old.add(&n, l0, fs);
+                new.add(&n, l0, fs);
+            }
+            assert_eq!(new.finish(vol), old.finish(vol));
+            let n = unit2(&mut r);
+            assert_eq!(
+                micro_modulus::strain_projector(&n),
+                reference::strain_projector(&n)
+            );
+            assert_eq!(
+                <D2 as Dimension<2>>::projector(&n),
+                reference::strain_projector(&n)
+            );
+        }
+    }
+
+    #[test]
+    fn two_d_stiffness_basis_and_fit_are_bit_identical() {
+        let mut r = ChaCha20Rng::seed_from_u64(4);
+        let mut fitted = 0;
+        for case in 0..5000 {
+            let l0 = range(&mut r, 1e-3, 2e-2);
+            let vol = 0.5 * 3f64.sqrt() * l0 * l0 * 0.1 * range(&mut r, 0.7, 1.3);
+            let rot = range(&mut r, 0.0, 1.0);
+            let kept: Vec<usize> = (0..6).filter(|_| r.next_u64() % 4 != 0).collect();
+            let bonds: Vec<(Vector2<f64>, f64)> = kept
+                .into_iter()
+                .map(|k| {
+                    let n = if case % 2 == 0 {
+                        let a = rot + k as f64 * std::f64::consts::PI / 3.0;
+                        Vector2::new(a.cos(), a.sin())
+                    } else {
+                        unit2(&mut r)
+                    };
+                    (n, l0 * range(&mut r, 0.8, 1.2))
+                })
+                .collect();
+            let want = reference::stiffness_basis(&bonds, vol);
+            assert_eq!(<D2 as Dimension<2>>::stiffness_basis(&bonds, vol), want);
+            assert_eq!(micro_modulus::stiffness_basis(&bonds, vol), want);
+            let d = reference::elasticity_matrix(30e9, range(&mut r, 0.0, 0.45), plane(&mut r));
+            let want = reference::fit(&bonds, vol, &d);
+            for got in [
+                <D2 as Dimension<2>>::fit(&bonds, vol, &d),
+                micro_modulus::fit(&bonds, vol, &d),
+            ] {
+                assert_eq!(got.map(|f| (f.moduli.a, f.moduli.b, f.residual)), want);
+            }
+            fitted += want.is_some() as usize;
+        }
+        assert!(fitted > 1000, "{fitted}");
+    }
+
+    // -- 3D principal values -------------------------------------------------------------
+
+    /// Asserts and returns the error relative to ‖t‖.
+    fn check_principal_3(t: &Matrix3<f64>, what: &str) -> f64 {
+        let p = principal_values_3(t);
+        let mut ev: Vec<f64> = t.symmetric_eigenvalues().iter().copied().collect();
+        ev.sort_by(|a, b| b.partial_cmp(a).unwrap());
+        let tol = 1e-12 * t.norm();
+        assert!(p[0] >= p[1] && p[1] >= p[2], "{what}: not sorted {p:?}");
+        for k in 0..3 {
+            assert!(
+                (p[k] - ev[k]).abs() <= tol,
+                "{what}: {p:?} vs {ev:?} (err {:e} of ‖t‖ = {:e})",
+                (p[k] - ev[k]).abs() / t.norm(),
+                t.norm()
+            );
+        }
+        assert_eq!(<D3 as Dimension<3>>::principal_values(t), p);
+        (0..3).map(|k| (p[k] - ev[k]).abs()).fold(0.0, f64::max) / t.norm().max(f64::MIN_POSITIVE)
+    }
+
+    #[test]
+    fn principal_values_3_match_nalgebra() {
+        let mut r = ChaCha20Rng::seed_from_u64(5);
+        let mut worst: f64 = 0.0;
+        check_principal_3(&Matrix3::zeros(), "zero");
+        check_principal_3(&Matrix3::identity(), "identity");
+        check_principal_3(&(Matrix3::identity() * -3e7), "hydrostatic");
+        check_principal_3(
+            &Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 3.0)),
+            "diagonal",
+        );
+        check_principal_3(
+            &Matrix3::new(1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0),
+            "rank-1",
+        );
+        for case in 0..20000 {
+            let sc = scale(&mut r, 10.0);
+            let t = match case % 6 {
+                // generic symmetric
+                0 => {
+                    let m = Matrix3::from_fn(|_, _| range(&mut r, -sc, sc));
+                    (m + m.transpose()) * 0.5
+                }
+                // exactly or nearly repeated eigenvalues in a random frame
+                1..=3 => {
+                    let q = rotation(&mut r);
+                    let l1 = range(&mut r, -sc, sc);
+                    let gap = match case % 6 {
+                        1 => 0.0,
+                        2 => sc * scale(&mut r, 7.0) * 1e-7,
+                        _ => sc * 10f64.powf(range(&mut r, -16.0, -3.0)),
+                    };
+                    let l3 = if case % 12 < 6 {
+                        range(&mut r, -sc, sc)
+                    } else {
+                        l1
+                    };
+                    let l = Vector3::new(l1, l1 + gap, l3);
+                    q * Matrix3::from_diagonal(&l) * q.transpose()
+                }
+                // large mean stress, small deviator
+                4 => {
+                    let m = Matrix3::from_fn(|_, _| range(&mut r, -sc, sc) * 1e-6);
+                    (m + m.transpose()) * 0.5 + Matrix3::identity() * range(&mut r, -sc, sc)
+                }
+                // sparse: some zero entries, some exact symmetry in the diagonal
+                _ => {
+                    let mut m = Matrix3::from_fn(|_, _| {
+                        if uni(&mut r) < 0.5 {
+                            0.0
+                        } else {
+                            range(&mut r, -sc, sc)
+                        }
+                    });
+                    m = (m + m.transpose()) * 0.5;
+                    if uni(&mut r) < 0.5 {
+                        m[(1, 1)] = m[(0, 0)];
+                    }
+                    m
+                }
+            };
+            // exactly symmetric input
+            let t = Matrix3::from_fn(|i, j| if i >= j { t[(i, j)] } else { t[(j, i)] });
+            worst = worst.max(check_principal_3(&t, &format!("case {case}")));
+        }
+        eprintln!("principal_values_3: worst error {worst:e} of ‖t‖");
+    }
+
+    // -- strain fit is exact on affine fields -----------------------------------------------
+
+    /// FCC slots with nearest spacing `l0`: 12 nearest directions, then 6 second neighbours
+    /// (the second neighbours' flag is true).
+    fn fcc_slots(rot: &Matrix3<f64>, l0: f64) -> [(Vector3<f64>, f64, bool); 18] {
+        let mut out = [(Vector3::zeros(), 0.0, false); 18];
+        let mut k = 0;
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            for s1 in [1.0, -1.0] {
+                for s2 in [1.0, -1.0] {
+                    let mut v = Vector3::zeros();
+                    v[i] = s1;
+                    v[j] = s2;
+                    out[k] = (rot * v.normalize(), l0, false);
+                    k += 1;
+                }
+            }
+        }
+        for i in 0..3 {
+            for s in [1.0, -1.0] {
+                let mut v = Vector3::zeros();
+                v[i] = s;
+                out[k] = (rot * v, 2f64.sqrt() * l0, true);
+                k += 1;
+            }
+        }
+        out
+    }
+
+    fn affine_fit_error<const K: usize>(
+        dirs: &[Option<Vector3<f64>>; K],
+        r: &mut ChaCha20Rng,
+    ) -> f64 {
+        let sc = scale(r, 5.0);
+        let g = Matrix3::from_fn(|_, _| range(r, -sc, sc));
+        let c = Vector3::from_fn(|_, _| range(r, -sc, sc));
+        let u = |x: &Vector3<f64>| c + g * x;
+        let xi = Vector3::from_fn(|_, _| range(r, -1.0, 1.0)) * 0.01;
+        let l0 = 0.01;
+        let mut s = [0.0; K];
+        for k in 0..K {
+            if let Some(n) = dirs[k] {
+                let xj = xi + n * l0;
+                s[k] = n.dot(&(u(&xj) - u(&xi))) / l0;
+            }
+        }
+        let p = <D3 as Dimension<3>>::strain_fit(dirs);
+        let e = <D3 as Dimension<3>>::strain_tensor(&p, &s);
+        let want = (g + g.transpose()) * 0.5;
+        (e - want).norm() / g.norm()
+    }
+
+    #[test]
+    fn three_d_strain_fit_is_exact_on_affine_fields() {
+        let mut r = ChaCha20Rng::seed_from_u64(6);
+        let mut worst: f64 = 0.0;
+        for case in 0..600 {
+            let rot = if case % 2 == 0 {
+                Matrix3::identity()
+            } else {
+                rotation(&mut r)
+            };
+            let slots = fcc_slots(&rot, 1.0);
+            // the lattice frame decides which slots a surface particle misses
+            let frame = fcc_slots(&Matrix3::identity(), 1.0);
+            let keep = |k: usize, which: usize| {
+                let n = frame[k].0;
+                match which {
+                    0 => true,                     // bulk
+                    1 => n.z <= 0.0,               // (001) surface
+                    _ => n.z <= 0.0 && n.x <= 0.0, // edge
+                }
+            };
+            for which in 0..3 {
+                let near: [Option<Vector3<f64>>; 12] =
+                    std::array::from_fn(|k| keep(k, which).then_some(slots[k].0));
+                let all: [Option<Vector3<f64>>; 18] =
+                    std::array::from_fn(|k| keep(k, which).then_some(slots[k].0));
+                if which < 2 {
+                    worst = worst.max(affine_fit_error(&near, &mut r));
+                }
+                worst = worst.max(affine_fit_error(&all, &mut r));
+            }
+            // random direction sets, some slots empty
+            let random: [Option<Vector3<f64>>; 18] =
+                std::array::from_fn(|k| (k < 9 || uni(&mut r) < 0.7).then(|| unit3(&mut r)));
+            worst = worst.max(affine_fit_error(&random, &mut r));
+        }
+        eprintln!("3D affine strain fit: worst error {worst:e} of ‖G‖");
+        assert!(worst <= 1e-12, "worst relative error {worst:e}");
+    }
+
+    #[test]
+    fn two_d_strain_fit_is_exact_on_affine_fields() {
+        let mut r = ChaCha20Rng::seed_from_u64(7);
+        for case in 0..4000 {
+            let sc = scale(&mut r, 5.0);
+            let g = Matrix2::from_fn(|_, _| range(&mut r, -sc, sc));
+            let rot = range(&mut r, 0.0, 1.0);
+            let missing = (r.next_u64() % 7) as usize; // 6: none missing
+            let dirs: [Option<Vector2<f64>>; 6] = if case % 2 == 0 {
+                // hexagonal slots, rotated, at most one missing (bulk or a straight edge)
+                std::array::from_fn(|k| {
+                    let a = rot + k as f64 * std::f64::consts::PI / 3.0;
+                    (k != missing).then(|| Vector2::new(a.cos(), a.sin()))
+                })
+            } else {
+                std::array::from_fn(|k| (k < 4 || uni(&mut r) < 0.5).then(|| unit2(&mut r)))
+            };
+            let s: [f64; 6] = std::array::from_fn(|k| dirs[k].map_or(0.0, |n| n.dot(&(g * n))));
+            let p = <D2 as Dimension<2>>::strain_fit(&dirs);
+            let e = <D2 as Dimension<2>>::strain_tensor(&p, &s);
+            let err = (e - (g + g.transpose()) * 0.5).norm() / g.norm();
+            if case % 2 == 0 {
+                assert!(err <= 1e-12, "hexagonal: {err:e}");
+            } else {
+                // random directions can be nearly dependent; the normal equations square
+                // the conditioning, measured by the largest projector entry ~ 1/σ_min(N)
+                let cond = p.iter().flatten().map(|x| x.abs()).fold(1.0, f64::max);
+                assert!(err <= 1e-14 * cond * cond, "{err:e}, cond {cond}");
+            }
+        }
+    }
+
+    // -- stress of a uniform strain is D·ε ---------------------------------------------------
+
+    fn uniform_strain_stress_3(
+        bonds: &[FccBond],
+        vol: f64,
+        m: (f64, f64, f64),
+        eps: &Matrix3<f64>,
+    ) -> Matrix3<f64> {
+        let (a, b, c) = m;
+        let ev = <D3 as Dimension<3>>::strain_to_voigt(eps);
+        let s: Vec<f64> = bonds
+            .iter()
+            .map(|(n, _, _)| Voigt6::projector(n).dot(&ev))
+            .collect();
+        let theta: f64 = s.iter().sum();
+        let mut acc = StressSum::<3>::default();
+        for ((n, l0, second), s) in bonds.iter().zip(&s) {
+            let modulus = if *second { a + c } else { a };
+            acc.add(n, *l0, modulus * s + b * theta);
+        }
+        acc.finish(vol)
+    }
+
+    #[test]
+    fn fcc_constants_reproduce_isotropic_elasticity() {
+        let mut r = ChaCha20Rng::seed_from_u64(8);
+        let (e, l0) = (30e9, 0.01);
+        let vol = fcc_volume(l0);
+        for nu in [0.0, 0.1, 0.2, 0.25, 1.0 / 3.0, 0.4, 0.45] {
+            let m = fcc(e, nu, l0);
+            assert!((2.0 * 2f64.sqrt() * (m.a + m.c) - m.a).abs() <= 1e-14 * m.a);
+            let d = <D3 as Dimension<3>>::elasticity(e, nu, Plane::Stress);
+            for case in 0..50 {
+                let rot = if case == 0 {
+                    Matrix3::identity()
+                } else {
+                    rotation(&mut r)
+                };
+                let bonds = fcc_slots(&rot, l0);
+                let (a_m, b_m, c_m) = micro_modulus::fcc_basis(&bonds, vol);
+                let model = a_m * m.a + b_m * m.b + c_m * m.c;
+                assert!((model - d).norm() <= 1e-13 * d.norm(), "nu={nu}");
+                // the least-squares fit recovers (4.8)
+                let f = fit_fcc(&bonds, vol, &d).unwrap();
+                assert!(f.residual < 1e-13, "nu={nu} residual {:e}", f.residual);
+                for (x, y) in [(f.moduli.a, m.a), (f.moduli.b, m.b), (f.moduli.c, m.c)] {
+                    assert!((x - y).abs() <= 1e-11 * m.a, "nu={nu}: {x} vs {y}");
+                }
+                // (3.18) under a uniform strain: σ = D·ε, with (4.8) and with the fit
+                for _ in 0..4 {
+                    let g = Matrix3::from_fn(|_, _| range(&mut r, -1e-4, 1e-4));
+                    let eps = (g + g.transpose()) * 0.5;
+                    let want = <D3 as Dimension<3>>::stress_of_strain(&d, &eps);
+                    for mm in [(m.a, m.b, m.c), (f.moduli.a, f.moduli.b, f.moduli.c)] {
+                        let sigma = uniform_strain_stress_3(&bonds, vol, mm, &eps);
+                        assert!(
+                            (sigma - want).norm() <= 1e-12 * want.norm(),
+                            "nu={nu}: {:e}",
+                            (sigma - want).norm() / want.norm()
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fcc_surface_particle_fit_is_stiffer_and_nearest_only_needs_no_c() {
+        let (e, nu, l0) = (30e9, 0.2, 0.01);
+        let vol = fcc_volume(l0);
+        let d = <D3 as Dimension<3>>::elasticity(e, nu, Plane::Strain);
+        let bulk = fcc(e, nu, l0);
+        let surface: Vec<FccBond> = fcc_slots(&Matrix3::identity(), l0)
+            .into_iter()
+            .filter(|(n, _, _)| n.z <= 0.0)
+            .collect();
+        let f = fit_fcc(&surface, vol, &d).unwrap();
+        assert!(f.moduli.a > bulk.a && f.moduli.a + f.moduli.c > 0.0);
+        assert!(f.residual > 0.0 && f.residual < 1.0);
+        // without second neighbours the c-basis vanishes: the (a, b) fit is the one to use
+        let near: Vec<FccBond> = fcc_slots(&Matrix3::identity(), l0)[..12].to_vec();
+        assert!(fit_fcc(&near, vol, &d).is_none());
+        let near_ab: Vec<(Vector3<f64>, f64)> = near.iter().map(|&(n, l, _)| (n, l)).collect();
+        let f = <D3 as Dimension<3>>::fit(&near_ab, vol, &d).unwrap();
+        assert!(f.moduli.a > 0.0 && f.residual > 0.0);
+        // three collinear-ish directions cannot carry it
+        let line = vec![(Vector3::x(), l0), (-Vector3::x(), l0)];
+        assert!(<D3 as Dimension<3>>::fit(&line, vol, &d).is_none());
+    }
+
+    #[test]
+    fn two_d_uniform_strain_stress_is_d_epsilon() {
+        let mut r = ChaCha20Rng::seed_from_u64(9);
+        let (e, l0, t) = (30e9, 0.01, 0.1);
+        let vol = 0.5 * 3f64.sqrt() * l0 * l0 * t;
+        for pl in [Plane::Stress, Plane::Strain] {
+            for nu in [0.0, 0.2, 1.0 / 3.0, 0.45] {
+                let m = hexagonal(e, nu, l0, t, pl);
+                let d = <D2 as Dimension<2>>::elasticity(e, nu, pl);
+                for _ in 0..20 {
+                    let rot = range(&mut r, 0.0, 1.0);
+                    let g = Matrix2::from_fn(|_, _| range(&mut r, -1e-4, 1e-4));
+                    let eps = (g + g.transpose()) * 0.5;
+                    let ev = Voigt3::strain_to_voigt(&eps);
+                    let dirs: Vec<Vector2<f64>> = (0..6)
+                        .map(|k| {
+                            let a = rot + k as f64 * std::f64::consts::PI / 3.0;
+                            Vector2::new(a.cos(), a.sin())
+                        })
+                        .collect();
+                    let s: Vec<f64> = dirs.iter().map(|n| Voigt3::projector(n).dot(&ev)).collect();
+                    let theta: f64 = s.iter().sum();
+                    let mut acc = StressSum::<2>::default();
+                    for (n, s) in dirs.iter().zip(&s) {
+                        acc.add(n, l0, m.a * s + m.b * theta);
+                    }
+                    // (3.18) holds per unit thickness: σ·t is what the lattice carries
+                    let sigma = acc.finish(vol);
+                    let want = D2::stress_of_strain(&d, &eps);
+                    assert!(
+                        (sigma - want).norm() <= 1e-12 * want.norm(),
+                        "{pl:?} nu={nu}"
+                    );
+                }
+            }
+        }
+    }
+
+    // -- 3D tensors -------------------------------------------------------------------------
+
+    #[test]
+    fn three_d_voigt_round_trips_and_projector_reads_strain() {
+        let mut r = ChaCha20Rng::seed_from_u64(10);
+        for _ in 0..1000 {
+            let g = Matrix3::from_fn(|_, _| range(&mut r, -1.0, 1.0));
+            let t = (g + g.transpose()) * 0.5;
+            assert!((Voigt6::voigt_to_strain(&Voigt6::strain_to_voigt(&t)) - t).norm() < 1e-15);
+            assert_eq!(Voigt6::voigt_to_stress(&Voigt6::stress_to_voigt(&t)), t);
+            let n = unit3(&mut r);
+            let s = n.dot(&(t * n));
+            assert!((Voigt6::projector(&n).dot(&Voigt6::strain_to_voigt(&t)) - s).abs() < 1e-14);
+            // σ = D·ε equals λ·tr(ε)·I + 2μ·ε
+            let (e, nu) = (30e9, range(&mut r, 0.0, 0.45));
+            let d = <D3 as Dimension<3>>::elasticity(e, nu, Plane::Strain);
+            let (lam, mu) = (
+                e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+                e / (2.0 * (1.0 + nu)),
+            );
+            let want = Matrix3::identity() * (lam * t.trace()) + t * (2.0 * mu);
+            let got = <D3 as Dimension<3>>::stress_of_strain(&d, &t);
+            assert!((got - want).norm() <= 1e-14 * want.norm());
+            // von Mises equals √(3/2)·‖dev σ‖; extremes are σ1, σ3
+            let dev = t - Matrix3::identity() * (t.trace() / 3.0);
+            let vm = (1.5 * dev.norm_squared()).sqrt();
+            assert!((<D3 as Dimension<3>>::von_mises(&t) - vm).abs() <= 1e-14 * t.norm());
+            assert_eq!(
+                <D3 as Dimension<3>>::equivalent_stress(&t, nu, Plane::Stress),
+                <D3 as Dimension<3>>::von_mises(&t)
+            );
+            let p = principal_values_3(&t);
+            assert_eq!(
+                <D3 as Dimension<3>>::principal_stress_extremes(&t, nu, Plane::Strain),
+                (p[0], p[2])
+            );
+            assert_eq!(
+                <D3 as Dimension<3>>::principal_strains(&t, nu, Plane::Stress),
+                (p[0], p[1], p[2])
+            );
+            assert!((<D3 as Dimension<3>>::max_principal(&t) - p[0]).abs() <= 1e-14);
+        }
+        assert_eq!(<D2 as Dimension<2>>::VOIGT, 3);
+        assert_eq!(<D3 as Dimension<3>>::VOIGT, 6);
+    }
+}
