@@ -13,6 +13,7 @@ pub mod limits;
 pub mod material;
 pub mod model;
 pub mod output;
+pub mod random_field;
 pub mod run;
 pub mod scene;
 pub mod solver;

@@ -179,7 +179,13 @@ fn plastic_block_carries_the_hardening_yield_stress() {
     let o = run(&scene, &RunOptions::default()).unwrap();
     let sigma = -o.records.last().unwrap().force_n / (0.15 * 0.15);
     // least-squares gradient of u over the middle half of the block
-    let g = common::fit_gradient(&o.x0, &o.displacement, |x| {
+    let x0: Vec<_> = o.x0.iter().map(|p| Vector2::new(p[0], p[1])).collect();
+    let u: Vec<_> = o
+        .displacement
+        .iter()
+        .map(|p| Vector2::new(p[0], p[1]))
+        .collect();
+    let g = common::fit_gradient(&x0, &u, |x| {
         (x.x - 0.075).abs() <= 0.04 && (x.y - 0.075).abs() <= 0.04
     });
     let (exx, eyy) = (g[(0, 0)], g[(1, 1)]);

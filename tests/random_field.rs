@@ -8,7 +8,7 @@
 use nalgebra::Vector2;
 use sppm::discretise::hex::HexLattice;
 use sppm::geometry::Shape2;
-use sppm::material::random_field::{
+use sppm::random_field::{
     weibull_cov, Correlation, FieldError, GaussianField, Marginal, NODES_PER_LENGTH,
 };
 

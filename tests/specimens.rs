@@ -16,13 +16,13 @@ fn mirror_asymmetry(o: &Outcome) -> f64 {
     let by_pos: HashMap<_, f64> =
         o.x0.iter()
             .zip(damage)
-            .map(|(x, w)| (key(x.x, x.y), w.wt))
+            .map(|(x, w)| (key(x[0], x[1]), w.wt))
             .collect();
     o.x0.iter()
         .zip(damage)
         .map(|(x, w)| {
             let m = by_pos
-                .get(&key(-x.x, x.y))
+                .get(&key(-x[0], x[1]))
                 .expect("the lattice is symmetric about x = 0");
             (w.wt - m).abs()
         })
@@ -58,15 +58,15 @@ fn split_cylinder_peak_crack_and_symmetry() {
     // particle farther than 0.2·R from it has w_t ≥ 0.5.
     let mut rows: HashMap<i64, (f64, f64, f64)> = HashMap::new();
     for (x, w) in o.x0.iter().zip(damage) {
-        if x.y.abs() > 0.2 * d {
+        if x[1].abs() > 0.2 * d {
             continue;
         }
-        let row = (x.y / (0.5 * 3f64.sqrt() * l0)).round() as i64;
+        let row = (x[1] / (0.5 * 3f64.sqrt() * l0)).round() as i64;
         let e = rows.entry(row).or_insert((0.0, 0.0, 0.0));
         if w.wt > e.0 {
-            *e = (w.wt, x.x, e.2);
+            *e = (w.wt, x[0], e.2);
         }
-        if x.x.abs() > 0.2 * r {
+        if x[0].abs() > 0.2 * r {
             e.2 = e.2.max(w.wt);
         }
     }
@@ -115,7 +115,7 @@ fn dogbone_b_peak_and_crack() {
             .map(|(x, _)| *x)
             .collect();
     assert!(cracked.len() >= 15, "{} cracked particles", cracked.len());
-    assert!(cracked.iter().all(|x| (x.y - 0.075).abs() <= 0.05));
+    assert!(cracked.iter().all(|x| (x[1] - 0.075).abs() <= 0.05));
     let worst = mirror_asymmetry(&o);
     assert!(worst <= 0.01, "asymmetric crack pattern: {worst}");
 }

@@ -1,6 +1,5 @@
 //! Elastic constants and the values derived from them for the dampers (MODEL.md §5).
 pub mod properties;
-pub mod random_field;
 
 /// Bulk modulus κ = E/(3(1−2ν)) as the source uses it for the wave speed (3.57).
 pub fn bulk_modulus(e: f64, nu: f64) -> f64 {

@@ -84,6 +84,21 @@ pub trait Layout<const D: usize, const V: usize> {
     fn voigt_to_stress(v: &SVector<f64, V>) -> Tensor<D>;
 }
 
+/// Micro-elastic constants of one particle (N; per unit stretch).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MicroModuli {
+    pub a: f64,
+    pub b: f64,
+}
+
+/// Result of the least-squares fit of one particle.
+#[derive(Clone, Copy, Debug)]
+pub struct Fit {
+    pub moduli: MicroModuli,
+    /// ‖a·A + b·B − D‖_F / ‖D‖_F.
+    pub residual: f64,
+}
+
 /// What the model asks of a spatial dimension D. Implemented for [`Dim<2>`] and [`Dim<3>`];
 /// code generic over `const D: usize` bounds `Dim<D>: Dimension<D>`.
 ///
@@ -150,11 +165,7 @@ pub trait Dimension<const D: usize>: Copy + Default + Debug + Send + Sync + 'sta
     ) -> (Self::Stiffness, Self::Stiffness);
     /// Least-squares a, b with D ≈ a·A + b·B (3.20); `None` when A is rank deficient or
     /// a ≤ 0 or not finite.
-    fn fit(
-        bonds: &[(Vector<D>, f64)],
-        volume: f64,
-        d: &Self::Stiffness,
-    ) -> Option<crate::model::micro_modulus::Fit>;
+    fn fit(bonds: &[(Vector<D>, f64)], volume: f64, d: &Self::Stiffness) -> Option<Fit>;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -438,11 +449,7 @@ impl Dimension<2> for Dim<2> {
     fn stiffness_basis(bonds: &[(Vector<2>, f64)], volume: f64) -> (Matrix3<f64>, Matrix3<f64>) {
         stiffness_basis::<2, 3, Voigt3>(bonds, volume)
     }
-    fn fit(
-        bonds: &[(Vector<2>, f64)],
-        volume: f64,
-        d: &Matrix3<f64>,
-    ) -> Option<crate::model::micro_modulus::Fit> {
+    fn fit(bonds: &[(Vector<2>, f64)], volume: f64, d: &Matrix3<f64>) -> Option<Fit> {
         fit_ab::<2, 3, Voigt3>(bonds, volume, d)
     }
 }
@@ -452,14 +459,14 @@ fn fit_ab<const D: usize, const V: usize, L: Layout<D, V>>(
     bonds: &[(Vector<D>, f64)],
     volume: f64,
     d: &SMatrix<f64, V, V>,
-) -> Option<crate::model::micro_modulus::Fit>
+) -> Option<Fit>
 where
     Const<V>: DimMin<Const<V>, Output = Const<V>>,
 {
     let (a_m, b_m) = stiffness_basis::<D, V, L>(bonds, volume);
     let ([a, b], residual) = least_squares(&[a_m, b_m], d, |_| true)?;
-    Some(crate::model::micro_modulus::Fit {
-        moduli: crate::model::micro_modulus::MicroModuli { a, b },
+    Some(Fit {
+        moduli: MicroModuli { a, b },
         residual,
     })
 }
@@ -679,11 +686,7 @@ impl Dimension<3> for Dim<3> {
     fn stiffness_basis(bonds: &[(Vector<3>, f64)], volume: f64) -> (Matrix6<f64>, Matrix6<f64>) {
         stiffness_basis::<3, 6, Voigt6>(bonds, volume)
     }
-    fn fit(
-        bonds: &[(Vector<3>, f64)],
-        volume: f64,
-        d: &Matrix6<f64>,
-    ) -> Option<crate::model::micro_modulus::Fit> {
+    fn fit(bonds: &[(Vector<3>, f64)], volume: f64, d: &Matrix6<f64>) -> Option<Fit> {
         fit_ab::<3, 6, Voigt6>(bonds, volume, d)
     }
 }

@@ -17,12 +17,7 @@ use super::dimension::{least_squares, Dim, Dimension};
 use crate::scene::Plane;
 use nalgebra::{Matrix3, Matrix6, Vector2, Vector3};
 
-/// Micro-elastic constants of one particle (N; per unit stretch).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MicroModuli {
-    pub a: f64,
-    pub b: f64,
-}
+pub use super::dimension::{Fit, MicroModuli};
 
 /// Constants of a bulk particle of the hexagonal lattice: (4.5) plane stress, (4.6) plane strain.
 pub fn hexagonal(e: f64, nu: f64, l0: f64, t: f64, plane: Plane) -> MicroModuli {
@@ -52,14 +47,6 @@ pub fn strain_projector(n: &Vector2<f64>) -> Vector3<f64> {
 /// volume ΔV: D_i = a·A + b·B. 2D wrapper of [`Dimension::stiffness_basis`].
 pub fn stiffness_basis(bonds: &[(Vector2<f64>, f64)], volume: f64) -> (Matrix3<f64>, Matrix3<f64>) {
     <Dim<2> as Dimension<2>>::stiffness_basis(bonds, volume)
-}
-
-/// Result of the least-squares fit of one particle.
-#[derive(Clone, Copy, Debug)]
-pub struct Fit {
-    pub moduli: MicroModuli,
-    /// ‖a·A + b·B − D‖_F / ‖D‖_F.
-    pub residual: f64,
 }
 
 /// Least-squares a, b with D ≈ a·A + b·B (3.20). Returns `None` when the bonds cannot carry

@@ -56,13 +56,13 @@ pub fn write_particles(o: &crate::run::Outcome, path: &Path) -> anyhow::Result<(
     for i in 0..o.x0.len() {
         let (x, u, s) = (o.x0[i], o.displacement[i], o.stress[i]);
         let mut row = vec![
-            format!("{:e}", x.x),
-            format!("{:e}", x.y),
-            format!("{:e}", u.x),
-            format!("{:e}", u.y),
-            format!("{:e}", s[(0, 0)]),
-            format!("{:e}", s[(1, 1)]),
-            format!("{:e}", s[(0, 1)]),
+            format!("{:e}", x[0]),
+            format!("{:e}", x[1]),
+            format!("{:e}", u[0]),
+            format!("{:e}", u[1]),
+            format!("{:e}", s[0]),
+            format!("{:e}", s[1]),
+            format!("{:e}", s[5]),
         ];
         if let Some(d) = &o.damage {
             row.push(format!("{}", d[i].wt));

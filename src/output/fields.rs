@@ -1,5 +1,6 @@
 //! Scalar particle fields for maps and VTK, with their labels and units.
 
+use crate::model::dimension::{Dim, Dimension};
 use crate::model::stress::{max_principal, von_mises};
 use crate::run::Outcome;
 use crate::scene::Field;
@@ -23,18 +24,38 @@ pub fn values(o: &Outcome, field: Field) -> Vec<f64> {
     let n = o.x0.len();
     (0..n)
         .map(|i| {
-            let u = o.displacement[i];
-            let s = o.stress[i];
+            let u = nalgebra::Vector3::from(o.displacement[i]);
+            let s = &o.stress[i];
             match field {
                 Field::Displacement => u.norm() * 1e3,
                 Field::DisplacementX => u.x * 1e3,
                 Field::DisplacementY => u.y * 1e3,
-                Field::StressXx => s[(0, 0)] * 1e-6,
-                Field::StressYy => s[(1, 1)] * 1e-6,
-                Field::StressXy => s[(0, 1)] * 1e-6,
-                Field::StressVonMises => von_mises(&s) * 1e-6,
-                Field::MaxPrincipalStress => max_principal(&s) * 1e-6,
+                Field::StressXx => s[0] * 1e-6,
+                Field::StressYy => s[1] * 1e-6,
+                Field::StressXy => s[5] * 1e-6,
+                Field::StressVonMises => equivalent(o, i, von_mises, Dim::<3>::von_mises) * 1e-6,
+                Field::MaxPrincipalStress => {
+                    equivalent(o, i, max_principal, Dim::<3>::max_principal) * 1e-6
+                }
             }
         })
         .collect()
+}
+
+/// A scalar of particle i's stress: of the in-plane tensor in 2D (plane stress, as the 2D maps
+/// always showed it), of the full tensor in 3D.
+fn equivalent(
+    o: &Outcome,
+    i: usize,
+    in_plane: fn(&nalgebra::Matrix2<f64>) -> f64,
+    solid: fn(&nalgebra::Matrix3<f64>) -> f64,
+) -> f64 {
+    if o.dim == 2 {
+        in_plane(&o.stress2(i))
+    } else {
+        let s = &o.stress[i];
+        solid(&nalgebra::Matrix3::new(
+            s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2],
+        ))
+    }
 }

@@ -155,7 +155,7 @@ impl Frame {
         let pos: Vec<(f64, f64)> =
             o.x0.iter()
                 .zip(&o.displacement)
-                .map(|(x, u)| ((x.x + scale * u.x) * 1e3, (x.y + scale * u.y) * 1e3))
+                .map(|(x, u)| ((x[0] + scale * u[0]) * 1e3, (x[1] + scale * u[1]) * 1e3))
                 .collect();
         let (mut x0, mut x1, mut y0, mut y1) = (
             f64::INFINITY,

@@ -22,9 +22,9 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     writeln!(w, "sppm {} particles", o.summary.scene)?;
     writeln!(w, "BINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS {n} float")?;
     for x in &o.x0 {
-        be(&mut w, x.x)?;
-        be(&mut w, x.y)?;
-        be(&mut w, 0.0)?;
+        for c in x {
+            be(&mut w, *c)?;
+        }
     }
     writeln!(w, "\nCELLS {n} {}", 2 * n)?;
     for i in 0..n {
@@ -38,23 +38,14 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     }
     writeln!(w, "\nPOINT_DATA {n}\nVECTORS displacement_m float")?;
     for u in &o.displacement {
-        be(&mut w, u.x)?;
-        be(&mut w, u.y)?;
-        be(&mut w, 0.0)?;
+        for c in u {
+            be(&mut w, *c)?;
+        }
     }
     writeln!(w, "\nTENSORS stress_Pa float")?;
     for s in &o.stress {
-        for v in [
-            s[(0, 0)],
-            s[(0, 1)],
-            0.0,
-            s[(1, 0)],
-            s[(1, 1)],
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-        ] {
+        // Voigt [xx, yy, zz, yz, xz, xy] to the row-major 3×3 tensor
+        for v in [s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2]] {
             be(&mut w, v)?;
         }
     }

@@ -5,6 +5,7 @@
 
 pub mod concrete;
 mod overrides;
+pub mod random_fields;
 mod resolve;
 mod validate;
 

@@ -83,7 +83,7 @@ impl Scene {
             }
         }
         self.validate_body()?;
-        crate::material::properties::check(self)?;
+        super::random_fields::check(self)?;
         let d = &self.discretisation;
         if d.lattice != "hexagonal" {
             return Err(invalid(

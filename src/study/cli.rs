@@ -4,8 +4,8 @@ use super::convergence::{convergence, ConvergenceArgs};
 use super::crack_path::CRACK_PATH_DAMAGE;
 use super::monte_carlo::{merge, monte_carlo, parse_shard, parse_sizes, MonteCarloArgs};
 use super::objectivity::{objectivity, ObjectivityArgs, DEFAULT_SEED};
+use super::options::parse_list;
 use super::runner::default_jobs;
-use anyhow::bail;
 use clap::Subcommand;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -105,33 +105,6 @@ pub struct StudyOptions {
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
-}
-
-/// The non-empty, trimmed items of a comma-separated option value.
-pub fn comma_items(text: &str) -> Vec<&str> {
-    text.split(',')
-        .map(str::trim)
-        .filter(|s| !s.is_empty())
-        .collect()
-}
-
-/// A comma-separated list of numbers; `option` names it in the message.
-pub fn parse_list(option: &str, text: &str) -> anyhow::Result<Vec<f64>> {
-    let items = comma_items(text);
-    if items.is_empty() {
-        bail!("{option} `{text}`: give a comma-separated list of at least one number");
-    }
-    items
-        .iter()
-        .map(|s| {
-            s.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    anyhow::anyhow!("{option} `{text}`: `{s}` is not a number (a comma-separated list of numbers is expected)")
-                })
-        })
-        .collect()
 }
 
 /// Run a study command; exit status 0, or 3 when a run did not complete (went unstable or

@@ -18,6 +18,7 @@ pub mod crack_path;
 pub mod extrapolation;
 pub mod monte_carlo;
 pub mod objectivity;
+pub mod options;
 pub mod pareto;
 pub mod plots;
 pub mod runner;

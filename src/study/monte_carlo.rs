@@ -33,8 +33,8 @@
 //!   folders into the same files.
 
 use super::runner::{RunOutputs, RunRow, Runs, Study, Variant};
-use super::size_effect_report::{report, tag_f64, SizeEffect};
-use crate::material::random_field::splitmix64;
+use super::size_effect_report::{report, size_um, tag_f64, SizeEffect};
+use crate::random_field::splitmix64;
 use crate::run::Outcome;
 use crate::scene::BodySpec;
 use crate::Scene;
@@ -90,7 +90,7 @@ pub fn parse_shard(text: &str) -> anyhow::Result<Shard> {
 /// Read `--sizes`: dog-bone letters A–F or sizes D in m (> 0), comma-separated; returned
 /// sorted and without repeats.
 pub fn parse_sizes(text: &str) -> anyhow::Result<Vec<f64>> {
-    let items = super::cli::comma_items(text);
+    let items = super::options::comma_items(text);
     if items.is_empty() {
         bail!("--sizes `{text}`: give dog-bone letters A–F or sizes D in m, comma-separated");
     }
@@ -113,11 +113,6 @@ pub fn parse_sizes(text: &str) -> anyhow::Result<Vec<f64>> {
     sizes.sort_by(f64::total_cmp);
     sizes.dedup_by(|a, b| size_um(*a) == size_um(*b));
     Ok(sizes)
-}
-
-/// A size in whole µm (the key of a size in seeds, labels and merges).
-pub fn size_um(d: f64) -> u64 {
-    (d * 1e6).round() as u64
 }
 
 /// The seed of realisation `r` (0-based) of size `d` (m) in a study of seed `study_seed`: a

@@ -10,7 +10,7 @@
 
 use super::crack_path::{crack_core, crack_path, mean_axis_deg};
 use super::runner::{RunResult, Study, Variant};
-use crate::material::random_field::splitmix64;
+use crate::random_field::splitmix64;
 use crate::run::Outcome;
 use crate::Scene;
 use anyhow::bail;
@@ -88,9 +88,11 @@ fn crack_metrics(o: &Outcome, threshold: f64) -> Vec<f64> {
     let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
     let count = |t: f64| wt.iter().filter(|w| **w >= t).count() as f64;
     let mut v = vec![count(super::crack_path::CRACKED), count(threshold)];
+    // the crack path in the plane of a 2D run
+    let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
     for line in [
-        crack_path(&o.x0, &wt, threshold),
-        crack_core(&o.x0, &wt, threshold),
+        crack_path(&x0, &wt, threshold),
+        crack_core(&x0, &wt, threshold),
     ] {
         match line {
             Some(p) => v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]]),

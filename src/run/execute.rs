@@ -1,0 +1,237 @@
+//! Stage 2 of a run: the explicit or relaxation solver on a prepared model, with probes, to
+//! a dimension-erased [`Outcome`].
+
+use super::prepare::{prepare, Prepared};
+use super::summary::{point3, summarise, voigt6, Finished, Outcome, SolverReport};
+use super::{RunError, RunOptions};
+use crate::material::properties;
+use crate::model::force_state::{dilatation_term, force_state};
+use crate::model::stress::StressSum;
+use crate::model::stretch::total_stretch;
+use crate::model::two_spring::TwoSpring;
+use crate::scene::{Scene, SolverMethod};
+use crate::solver::concrete::Concrete;
+use crate::solver::mechanics::Mechanics;
+use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
+use nalgebra::{Matrix2, Vector2};
+use std::time::Instant;
+
+/// Particle stresses (3.18) at positions x: σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(e_ij ⊗ e_ij)
+/// with F_s,ij = a_i·S_ij + b_i·Σ_m S_im and e_ij the current bond direction.
+pub fn particle_stress(
+    mech: &Mechanics<2, 6>,
+    volume: &[f64],
+    x: &[Vector2<f64>],
+) -> Vec<Matrix2<f64>> {
+    (0..x.len())
+        .map(|i| {
+            let mut theta = 0.0;
+            for (_, j, il) in mech.bonds(i) {
+                theta += total_stretch((x[j] - x[i]).norm(), il);
+            }
+            let mut acc = StressSum::default();
+            for (_, j, il) in mech.bonds(i) {
+                let d = x[j] - x[i];
+                let len = d.norm();
+                let s = total_stretch(len, il);
+                acc.add(
+                    &(d / len),
+                    1.0 / il,
+                    force_state(mech.a[i], s, dilatation_term(mech.b[i], theta)),
+                );
+            }
+            acc.finish(volume[i])
+        })
+        .collect()
+}
+
+/// Run a scene to its end. A run that goes unstable stops there and its outcome says so
+/// (`summary.status = "unstable"`, `summary.message` names the step and the particle).
+pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
+    let threads = opts
+        .threads
+        .or(scene.solver.threads)
+        .unwrap_or_else(rayon::current_num_threads);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| RunError::Setup(format!("cannot start {threads} threads: {e}")))?;
+    pool.install(|| run_prepared(prepare(scene)?, opts, threads))
+}
+
+/// The simulation of a prepared scene, at rest, taking over the model's arrays (no copy);
+/// with `[concrete]`, the damage and plasticity kernel is on.
+pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
+    let integration = Integration {
+        dt: p.dt,
+        lagged_forces: p.model.scene.solver.force_lag == crate::scene::ForceLag::Previous,
+        ramp: p.model.scene.loading.ramp,
+        t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
+    };
+    let mut sim = Simulation::new(
+        p.model.particles.x0.clone(),
+        std::mem::take(&mut p.model.mech),
+        std::mem::take(&mut p.model.prescribed),
+        integration,
+    );
+    if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
+        let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
+        let c: Concrete<6> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
+        sim.inelastic = Some(Box::new(c));
+    }
+    sim
+}
+
+fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
+    let start = Instant::now();
+    let method = p.model.scene.solver.method;
+    if method == SolverMethod::Relaxation {
+        // Dampers off; the step of the undamped model (see solver::relaxation).
+        p.stable = relaxation::undamped(&mut p.model.mech, &p.model.particles.x0);
+        p.dt = p
+            .model
+            .scene
+            .solver
+            .dt
+            .unwrap_or(p.model.scene.solver.safety * p.stable.dt_stable);
+    }
+    let mut sim = build_simulation(&mut p);
+    let empty_probe = Probe {
+        members: vec![],
+        component: 1,
+        amplitude: 0.0,
+    };
+    let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
+    let (records, wall_s, failure, report) = match method {
+        SolverMethod::Explicit => {
+            let (records, wall_s, failure, stopped) =
+                run_explicit(&mut sim, &p, probe, opts, start);
+            let report = SolverReport {
+                stopped_after_peak: stopped,
+                ..Default::default()
+            };
+            (records, wall_s, failure, report)
+        }
+        SolverMethod::Relaxation => {
+            let s = &p.model.scene.solver;
+            let settings = relaxation::Settings {
+                increments: s.increments,
+                tolerance: s.tolerance,
+                max_iterations: s.max_iterations,
+                ramp: p.model.scene.loading.ramp,
+                stop_after_peak: p.model.scene.loading.stop_after_peak,
+            };
+            let r = relaxation::relax(&mut sim, probe, &settings, start);
+            let report = SolverReport {
+                iterations: Some(r.iterations),
+                increments: Some(s.increments),
+                unconverged_increments: Some(r.unconverged_increments),
+                max_final_residual: Some(r.max_final_residual),
+                stopped_after_peak: r.stopped_after_peak,
+            };
+            (r.records, r.wall_s, r.failure, report)
+        }
+    };
+    let wall = start.elapsed().as_secs_f64();
+    let x = sim.state.x.clone();
+    let displacement: Vec<Vector2<f64>> = x
+        .iter()
+        .zip(&p.model.particles.x0)
+        .map(|(a, b)| a - b)
+        .collect();
+    let (stress, damage) = match &sim.inelastic {
+        Some(model) => (
+            model.particle_stress(&sim.mech, &x, &p.model.particles.volume),
+            Some(model.damage()),
+        ),
+        None => (
+            particle_stress(&sim.mech, &p.model.particles.volume, &x),
+            None,
+        ),
+    };
+    let summary = summarise(
+        &p,
+        &Finished {
+            kernel: sim.kernel(),
+            method,
+            report,
+            records: &records,
+            wall_s: &wall_s,
+            wall,
+            threads,
+            steps_done: sim.step,
+            failure: failure.as_ref().map(|e| e.to_string()),
+        },
+        damage.as_deref(),
+    );
+    let outcome = Outcome {
+        summary,
+        records,
+        dim: 2,
+        x0: p.model.particles.x0.iter().map(point3).collect(),
+        displacement: displacement.iter().map(point3).collect(),
+        stress: stress.iter().map(voigt6).collect(),
+        damage,
+        groups: p.model.groups.clone(),
+        scene: p.model.scene.clone(),
+        fields: p.model.fields.clone(),
+    };
+    Ok(outcome)
+}
+
+/// The explicit run to t_end with probe records (and the wall time at each), stopping at an
+/// instability, or after the peak with `loading.stop_after_peak` (then `true`).
+fn run_explicit(
+    sim: &mut Simulation<2, 6>,
+    p: &Prepared,
+    probe: &Probe,
+    opts: &RunOptions,
+    start: Instant,
+) -> (Vec<Record>, Vec<f64>, Option<crate::solver::Unstable>, bool) {
+    let mut stop = PeakStop::new(p.model.scene.loading.stop_after_peak, probe);
+    let mut stopped = false;
+    let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
+    let bar = if opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7 {
+        let b = indicatif::ProgressBar::new(p.steps as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} {wide_bar} {pos}/{len} steps  {elapsed_precise} ETA {eta}",
+            )
+            .unwrap(),
+        );
+        Some(b)
+    } else {
+        None
+    };
+    let mut records = Vec::with_capacity(p.model.scene.output.records + 1);
+    let mut wall_s = Vec::with_capacity(p.model.scene.output.records + 1);
+    let mut failure = None;
+    for n in 0..p.steps {
+        let want = n % every == 0 || n + 1 == p.steps;
+        let rec = sim.advance(if want { Some(probe) } else { None });
+        if let Some(r) = rec {
+            records.push(r);
+            wall_s.push(start.elapsed().as_secs_f64());
+        }
+        if want || n % 64 == 0 {
+            let u = rec.map(|r| r.internal_j);
+            if let Err(e) = sim.check_stability(u, true) {
+                failure = Some(e);
+                break;
+            }
+        }
+        if rec.is_some_and(|r| stop.reached(&r, sim)) {
+            stopped = true;
+            break;
+        }
+        if let Some(b) = &bar {
+            if n % 256 == 0 {
+                b.set_position(n as u64);
+            }
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    (records, wall_s, failure, stopped)
+}

@@ -1,0 +1,378 @@
+//! Stage 1 of a run: discretise a scene and assemble its model (body, groups, supports,
+//! micro-moduli, random fields), then T1, the dampers and the stable time step.
+
+use super::RunError;
+use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
+use crate::limits::available_memory;
+use crate::material;
+use crate::material::properties::{self, SampledField};
+use crate::model::micro_modulus::{self, MicroModuli};
+use crate::scene::Scene;
+use crate::solver::loading::Prescribed;
+use crate::solver::mechanics::Mechanics;
+use crate::solver::time_step::{stable_step, StableStep};
+use crate::solver::{modal, Probe};
+use nalgebra::Vector2;
+use serde::Serialize;
+
+/// Statistics of the surface correction (MODEL.md §3).
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceCorrection {
+    pub enabled: bool,
+    /// Particles with fewer than six bonds.
+    pub boundary_particles: usize,
+    /// Boundary particles given fitted constants.
+    pub corrected: usize,
+    /// Boundary particles whose bonds cannot carry a fit (kept at bulk constants).
+    pub kept_bulk: usize,
+    /// Largest ‖a·A + b·B − D‖/‖D‖ among the corrected particles.
+    pub max_residual: f64,
+}
+
+/// A discretised, assembled specimen ready to run: the model plus its dynamics.
+pub struct Prepared {
+    pub model: Model,
+    pub fundamental: modal::Fundamental,
+    pub stable: StableStep,
+    pub dt: f64,
+    pub t_end: f64,
+    pub steps: usize,
+    pub probe: Option<(String, Probe)>,
+}
+
+/// Particles the body will hold (area / cell area), known before anything is allocated.
+pub fn estimated_particles(scene: &Scene) -> f64 {
+    let l0 = scene.discretisation.spacing;
+    scene.shape().area() / (0.5 * 3f64.sqrt() * l0 * l0)
+}
+
+/// Estimated bytes a run allocates.
+pub fn estimated_memory(scene: &Scene) -> f64 {
+    estimated_particles(scene) * bytes_per_particle(2, 6) as f64
+}
+
+/// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step).
+pub struct Model {
+    pub scene: Scene,
+    pub particles: Particles<2, 6>,
+    pub groups: Vec<groups::Group>,
+    pub prescribed: Vec<Prescribed>,
+    pub constrained: Vec<[bool; 2]>,
+    pub mech: Mechanics<2, 6>,
+    pub bulk: MicroModuli,
+    pub surface: SurfaceCorrection,
+    /// The scene's random fields sampled at the particles (MODEL.md §12).
+    pub fields: Vec<SampledField>,
+}
+
+/// Discretise a scene and assemble its model: lattice, groups, supports, micro-moduli.
+pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
+    prepare_model_with(scene, &|_| {})
+}
+
+/// [`prepare_model`], telling `stage` what it starts (for `sppm check` of large bodies).
+pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, RunError> {
+    let d = &scene.discretisation;
+    let m = &scene.material;
+    let need = estimated_memory(scene);
+    if let Some(avail) = available_memory() {
+        if need > 0.8 * avail as f64 {
+            return Err(RunError::Setup(format!(
+                "discretisation.spacing = {}: the body would hold about {:.3e} particles needing about {:.1} GiB, more than this machine has available ({:.1} GiB); use a larger spacing",
+                d.spacing,
+                estimated_particles(scene),
+                need / 2f64.powi(30),
+                avail as f64 / 2f64.powi(30)
+            )));
+        }
+    }
+    if estimated_particles(scene) > u32::MAX as f64 / 2.0 {
+        return Err(RunError::Setup(format!(
+            "discretisation.spacing = {}: about {:.3e} particles, more than the 2.1e9 a run can index",
+            d.spacing,
+            estimated_particles(scene)
+        )));
+    }
+    let shape = scene.shape();
+    let lattice = HexLattice {
+        spacing: d.spacing,
+        rotation_deg: d.rotation_deg,
+        offset: Vector2::new(d.offset[0], d.offset[1]),
+        thickness: m.thickness,
+    };
+    stage(&format!(
+        "filling the body with about {:.3e} particles",
+        estimated_particles(scene)
+    ));
+    let particles = lattice.fill(&shape);
+    if particles.len() < 2 {
+        return Err(RunError::Setup(format!(
+            "discretisation.spacing = {}: the body holds {} bonded particles at this spacing, rotation and offset; at least 2 are needed (use a smaller spacing)",
+            d.spacing,
+            particles.len()
+        )));
+    }
+
+    // Groups, supports and loading.
+    let n = particles.len();
+    let mut groups = Vec::new();
+    let mut constrained = vec![[false; 2]; n];
+    let mut amplitude: Vec<[Option<(f64, String)>; 2]> = vec![[None, None]; n];
+    let (body_lo, body_hi) = shape.bounding_box();
+    for g in &scene.groups {
+        let members = groups::select(&g.select, &particles, &shape);
+        if members.is_empty() {
+            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                key: format!("groups.{}.select", g.name),
+                value: g.select.scene_text(),
+                allowed: format!(
+                    "a selection that contains at least one particle; the body spans x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m",
+                    body_lo.x, body_hi.x, body_lo.y, body_hi.y
+                ),
+            }));
+        }
+        let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
+        if let Some(l) = &g.load {
+            entries.push((l.component.index(), l.delta()));
+        }
+        for &i in &members {
+            for &(c, amp) in &entries {
+                let slot = &mut amplitude[i as usize][c];
+                match slot {
+                    Some((prev, other)) if *prev != amp => {
+                        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                            key: format!("groups.{}", g.name),
+                            value: format!("particle {i} at {:?}", particles.x0[i as usize].as_slice()),
+                            allowed: format!(
+                                "groups that overlap must prescribe the same displacement: groups.{other} already prescribes {prev} m in component {c}, this group {amp} m"
+                            ),
+                        }))
+                    }
+                    _ => *slot = Some((amp, g.name.clone())),
+                }
+                constrained[i as usize][c] = true;
+            }
+        }
+        groups.push(groups::Group {
+            name: g.name.clone(),
+            members,
+        });
+    }
+    let prescribed: Vec<Prescribed> = (0..n)
+        .flat_map(|i| {
+            let a = amplitude[i].clone();
+            (0..2).filter_map(move |c| {
+                a[c].as_ref().map(|(amp, _)| Prescribed {
+                    particle: i as u32,
+                    component: c as u8,
+                    amplitude: *amp,
+                })
+            })
+        })
+        .collect();
+
+    // Micro-moduli, with the surface correction of particles that miss bonds.
+    stage("micro-moduli and the surface correction");
+    // Bulk constants (4.5), (4.6) of each particle's own spacing; reported at the nominal one.
+    let bulk = micro_modulus::hexagonal(m.youngs_modulus(), m.nu, d.spacing, m.thickness, m.plane);
+    let dmat = micro_modulus::elasticity_matrix(m.youngs_modulus(), m.nu, m.plane);
+    let own: Vec<MicroModuli> = (0..n)
+        .map(|i| {
+            micro_modulus::hexagonal(
+                m.youngs_modulus(),
+                m.nu,
+                particles.length[i],
+                m.thickness,
+                m.plane,
+            )
+        })
+        .collect();
+    let mut a: Vec<f64> = own.iter().map(|mm| mm.a).collect();
+    let mut b: Vec<f64> = own.iter().map(|mm| mm.b).collect();
+    let mut surface = SurfaceCorrection {
+        enabled: d.surface_correction,
+        boundary_particles: 0,
+        corrected: 0,
+        kept_bulk: 0,
+        max_residual: 0.0,
+    };
+    for i in 0..n {
+        if particles.bond_count(i) == 6 {
+            continue;
+        }
+        surface.boundary_particles += 1;
+        if !d.surface_correction {
+            continue;
+        }
+        let bonds: Vec<(Vector2<f64>, f64)> = (0..6)
+            .filter(|&k| particles.neighbours[i][k] != crate::discretise::NONE)
+            .map(|k| {
+                let j = particles.neighbours[i][k] as usize;
+                (
+                    (particles.x0[j] - particles.x0[i]).normalize(),
+                    particles.l0[i][k],
+                )
+            })
+            .collect();
+        match micro_modulus::fit(&bonds, particles.volume[i], &dmat) {
+            Some(f) => {
+                a[i] = f.moduli.a;
+                b[i] = f.moduli.b;
+                surface.corrected += 1;
+                surface.max_residual = surface.max_residual.max(f.residual);
+            }
+            None => surface.kept_bulk += 1,
+        }
+    }
+    if !scene.random_field.is_empty() {
+        stage("random fields");
+    }
+    // Random fields (MODEL.md §12), over the body's box: E scales the micro-moduli here, the
+    // concrete values go to the damage kernel (`build_simulation`).
+    // The box is widened by a margin that does not depend on the spacing (particles may sit
+    // on the outline within the lattice fill's tolerance, 1e-9·size).
+    let pad = Vector2::repeat(1e-6 * shape.size().max(1.0));
+    let fields = properties::sample(scene, body_lo - pad, body_hi + pad, &particles.x0)?;
+    properties::check_strengths(scene, &fields)?;
+    if let Some(f) = properties::stiffness_factors(&fields, m.youngs_modulus()) {
+        for i in 0..n {
+            a[i] *= f[i];
+            b[i] *= f[i];
+        }
+    }
+    let mut particles = particles;
+    particles.a = a;
+    particles.b = b;
+    let rho = vec![m.rho; n];
+    let mech = Mechanics::new(&particles, &rho);
+    Ok(Model {
+        scene: scene.clone(),
+        particles,
+        groups,
+        prescribed,
+        constrained,
+        mech,
+        bulk,
+        surface,
+        fields,
+    })
+}
+
+/// A failed modal analysis, with the scene keys T1 depends on.
+fn modal_failure(model: &Model, e: modal::ModalError) -> RunError {
+    let text = e.to_string();
+    if text.contains("every particle is constrained") {
+        return RunError::Setup(format!("{text}: groups fix or load every component of every particle, so nothing is left to move; free some components (groups.*.fix, groups.*.load)"));
+    }
+    // A particle with one bond has no stiffness across it: a zero-frequency mode.
+    let p = &model.particles;
+    let single: Vec<usize> = (0..p.len()).filter(|&i| p.bond_count(i) == 1).collect();
+    let hanging = match single.first() {
+        Some(&i) => format!(
+            " {} particle(s) hang by a single bond and swing freely across it (e.g. particle {i} at {:?}): change discretisation.spacing, discretisation.rotation_deg or discretisation.offset, or the body's sharp corners.",
+            single.len(),
+            p.x0[i].as_slice()
+        ),
+        None => String::new(),
+    };
+    let m = &model.scene.material;
+    RunError::Setup(format!(
+        "{text}. T1 is the lowest mode of the lattice held by its supports (groups.*.fix, groups.*.load); it cannot be found when the supports leave a mechanism, or when material.nu = {} is so close to -1 or 0.5 that the stiffness is too ill-conditioned ({:?} plane).{hanging}",
+        m.nu, m.plane
+    ))
+}
+
+/// Discretise and assemble a scene, compute T1 and the time step.
+pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
+    prepare_with(scene, &|_| {})
+}
+
+/// [`prepare`], telling `stage` what it starts (for `sppm check` of large bodies).
+pub fn prepare_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Prepared, RunError> {
+    let mut model = prepare_model_with(scene, stage)?;
+    stage("fundamental period T1 (Lanczos)");
+    let m = &scene.material;
+    let n = model.particles.len();
+    let fundamental = modal::fundamental(&model.mech, &model.particles.x0, &model.constrained)
+        .map_err(|e| modal_failure(&model, e))?;
+    let omega_struct = 2.0 * std::f64::consts::PI / fundamental.period;
+    let mech = &mut model.mech;
+    for i in 0..n {
+        // ω_i from the particle's own length scale (section 4.3)
+        let omega_i = material::particle_frequency(
+            m.youngs_modulus(),
+            m.nu,
+            m.rho,
+            model.particles.length[i],
+        );
+        mech.c_in[i] = 2.0 * mech.mass[i] * scene.damping.internal * omega_i;
+        mech.c_ex[i] = 2.0 * mech.mass[i] * scene.damping.external * omega_struct;
+    }
+    stage("stable time step (largest frequency, Lanczos)");
+    let stable = stable_step(&model.mech, &model.particles.x0);
+    let dt = match scene.solver.dt {
+        Some(dt) if dt > stable.dt_stable => {
+            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                key: "solver.dt".into(),
+                value: format!("{dt:e}"),
+                allowed: format!(
+                    "at most the stable limit {:.6e} s computed from the stiffness, masses and damping (or leave solver.dt out to use solver.safety × the limit)",
+                    stable.dt_stable
+                ),
+            }))
+        }
+        Some(dt) => dt,
+        None => scene.solver.safety * stable.dt_stable,
+    };
+    let t_end = match (scene.loading.end_periods, scene.loading.end_s) {
+        (Some(p), _) => p * fundamental.period,
+        (None, Some(s)) => s,
+        (None, None) => 10.0 * fundamental.period,
+    };
+    let steps = (t_end / dt).ceil() as usize;
+    if steps as f64 * n as f64 > 1e14 {
+        return Err(RunError::Setup(format!(
+            "loading: t_end = {t_end:.3e} s needs {steps} steps of {n} particles, beyond 1e14 particle-steps; shorten loading.end_periods or coarsen discretisation.spacing"
+        )));
+    }
+
+    let probe_name = scene.output.probe_group.clone().or_else(|| {
+        scene
+            .groups
+            .iter()
+            .find(|g| g.load.is_some())
+            .map(|g| g.name.clone())
+    });
+    let probe = probe_name.map(|name| {
+        let spec = scene.groups.iter().find(|g| g.name == name).unwrap();
+        let members = model
+            .groups
+            .iter()
+            .find(|g| g.name == name)
+            .unwrap()
+            .members
+            .clone();
+        let (component, amplitude) = match &spec.load {
+            Some(l) => (l.component.index(), l.delta()),
+            None => (spec.fix[0].index(), 0.0),
+        };
+        (
+            name,
+            Probe {
+                members,
+                component,
+                amplitude,
+            },
+        )
+    });
+
+    Ok(Prepared {
+        model,
+        fundamental,
+        stable,
+        dt,
+        t_end,
+        steps,
+        probe,
+    })
+}

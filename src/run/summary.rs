@@ -1,0 +1,310 @@
+//! Stage 3 of a run: what it measured (summary.json) and the dimension-erased outcome handed
+//! to `output` and `study`.
+
+use super::prepare::{Prepared, SurfaceCorrection};
+use crate::discretise::groups;
+use crate::material::properties::{FieldReport, SampledField};
+use crate::scene::{Scene, SolverMethod};
+use crate::solver::concrete::ParticleDamage;
+use crate::solver::Record;
+use serde::Serialize;
+
+/// The summary of a run (summary.json; the keys ARCHITECTURE.md names, and more).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub scene: String,
+    pub description: Option<String>,
+    pub status: String,
+    pub message: Option<String>,
+    pub particles: usize,
+    pub bonds: usize,
+    pub steps: usize,
+    pub dt_s: f64,
+    pub dt_stable_s: f64,
+    pub safety: f64,
+    pub fundamental_period_s: f64,
+    pub t_end_s: f64,
+    pub wall_time_s: f64,
+    /// Wall time from the start of the run to the record of the peak force.
+    pub wall_time_to_peak_s: f64,
+    /// Step of the peak record.
+    pub peak_step: usize,
+    pub solver_method: SolverMethod,
+    /// Relaxation: kernel steps of all increments.
+    pub iterations: Option<usize>,
+    /// Relaxation: load increments.
+    pub increments: Option<usize>,
+    /// Relaxation: increments that stopped at solver.max_iterations.
+    pub unconverged_increments: Option<usize>,
+    /// Relaxation: largest out-of-balance force norm / reaction norm at the end of an
+    /// increment.
+    pub max_final_residual: Option<f64>,
+    /// The run stopped after its peak (`loading.stop_after_peak`), before t_end.
+    pub stopped_after_peak: bool,
+    pub threads: usize,
+    pub probe_group: Option<String>,
+    #[serde(rename = "peak_force_N")]
+    pub peak_force_n: f64,
+    pub displacement_at_peak_m: f64,
+    pub final_displacement_m: f64,
+    #[serde(rename = "final_force_N")]
+    pub final_force_n: f64,
+    /// External work not found in kinetic, elastic or damper energy (damage and plasticity;
+    /// for an elastic scene a measure of the energy error).
+    #[serde(rename = "dissipated_energy_J")]
+    pub dissipated_energy_j: f64,
+    #[serde(rename = "damping_energy_J")]
+    pub damping_energy_j: f64,
+    #[serde(rename = "external_work_J")]
+    pub external_work_j: f64,
+    #[serde(rename = "internal_energy_J")]
+    pub internal_energy_j: f64,
+    #[serde(rename = "kinetic_energy_J")]
+    pub kinetic_energy_j: f64,
+    /// Largest kinetic/internal energy ratio before and around the peak (the records up to
+    /// the peak and after it while the force stays at 80% of the peak or more), over the records where the internal energy is
+    /// at least 1% of its maximum (the quasi-static check).
+    pub max_kinetic_to_internal_energy: f64,
+    /// The same over the whole run (after complete failure the elastic energy vanishes and
+    /// this ratio says little).
+    pub max_kinetic_to_internal_energy_whole_run: f64,
+    /// Largest tensile damage w_t (scenes with `[concrete]`).
+    pub max_damage: Option<f64>,
+    pub max_compressive_damage: Option<f64>,
+    /// Particles with w_t ≥ 0.99.
+    pub cracked_particles: Option<usize>,
+    /// Particles with w_c ≥ 0.99.
+    pub crushed_particles: Option<usize>,
+    /// Particles that yielded at least once.
+    pub yielded_particles: Option<usize>,
+    /// The concrete law used (every value resolved).
+    pub concrete: Option<crate::model::damage::ConcreteLaw>,
+    /// Material values and where each came from (scene, preset or correlation).
+    pub material_values: Vec<crate::scene::concrete::Derived>,
+    pub force_lag: crate::scene::ForceLag,
+    /// The step kernel chosen for the scene's features: elastic, tension or full.
+    pub kernel: crate::solver::KernelSet,
+    pub surface_correction: SurfaceCorrection,
+    pub micro_modulus_a_bulk: f64,
+    pub micro_modulus_b_bulk: f64,
+    pub spacing_m: f64,
+    pub rotation_deg: f64,
+    pub offset_m: [f64; 2],
+    pub omega_max_rad_s: f64,
+    pub omega_max_bound_rad_s: f64,
+    /// The scene's seed (`Scene::effective_seed`), `None` when it makes no random choice.
+    pub seed: Option<u64>,
+    /// Each random field: its parameters, seed and the statistics of the particles' values.
+    pub random_fields: Vec<FieldReport>,
+    pub sppm_version: String,
+}
+
+/// What a run produces, dimension-erased: points and displacements as 3-vectors (z = 0 in
+/// 2D), stresses as 6 Voigt components [σxx, σyy, σzz, σyz, σxz, σxy] (in 2D the
+/// out-of-plane components are 0, as the 2D reports always showed them), so that `output`
+/// and `study` serve every dimension from one copy.
+pub struct Outcome {
+    pub summary: Summary,
+    pub records: Vec<Record>,
+    /// Spatial dimension of the run (2 or 3).
+    pub dim: usize,
+    pub x0: Vec<[f64; 3]>,
+    pub displacement: Vec<[f64; 3]>,
+    pub stress: Vec<[f64; 6]>,
+    /// Damage and plasticity state of each particle at the end (scenes with `[concrete]`).
+    pub damage: Option<Vec<ParticleDamage>>,
+    pub groups: Vec<groups::Group>,
+    pub scene: Scene,
+    /// The random fields' values at each particle (MODEL.md §12).
+    pub fields: Vec<SampledField>,
+}
+
+impl Outcome {
+    pub fn failed(&self) -> bool {
+        self.summary.status != "completed"
+    }
+
+    /// The in-plane reference position of particle i (x, y).
+    pub fn point2(&self, i: usize) -> nalgebra::Vector2<f64> {
+        nalgebra::Vector2::new(self.x0[i][0], self.x0[i][1])
+    }
+
+    /// The in-plane stress tensor of particle i (σxx, σyy, σxy).
+    pub fn stress2(&self, i: usize) -> nalgebra::Matrix2<f64> {
+        let s = &self.stress[i];
+        nalgebra::Matrix2::new(s[0], s[5], s[5], s[1])
+    }
+}
+
+/// A point of dimension D as a 3-vector (zeros beyond D).
+pub fn point3<const D: usize>(p: &nalgebra::SVector<f64, D>) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (o, v) in out.iter_mut().zip(p.iter()) {
+        *o = *v;
+    }
+    out
+}
+
+/// A symmetric D×D stress as 6 Voigt components [xx, yy, zz, yz, xz, xy] (zeros beyond D).
+pub fn voigt6<const D: usize>(s: &nalgebra::SMatrix<f64, D, D>) -> [f64; 6] {
+    let at = |r: usize, c: usize| if r < D && c < D { s[(r, c)] } else { 0.0 };
+    [at(0, 0), at(1, 1), at(2, 2), at(1, 2), at(0, 2), at(0, 1)]
+}
+
+/// What the relaxation solver adds to the summary (`None` for the explicit one).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct SolverReport {
+    pub iterations: Option<usize>,
+    pub increments: Option<usize>,
+    pub unconverged_increments: Option<usize>,
+    pub max_final_residual: Option<f64>,
+    pub stopped_after_peak: bool,
+}
+
+/// What a finished run hands to its summary.
+pub(super) struct Finished<'a> {
+    pub kernel: crate::solver::KernelSet,
+    pub method: SolverMethod,
+    pub report: SolverReport,
+    pub records: &'a [Record],
+    /// Wall time (s since the start) at each record.
+    pub wall_s: &'a [f64],
+    pub wall: f64,
+    pub threads: usize,
+    /// Kernel steps taken (the step an unstable run stopped at, not only the last record).
+    pub steps_done: usize,
+    pub failure: Option<String>,
+}
+
+pub(super) fn summarise(
+    p: &Prepared,
+    run: &Finished,
+    damage: Option<&[ParticleDamage]>,
+) -> Summary {
+    let Finished {
+        kernel,
+        method,
+        report,
+        records,
+        wall_s,
+        wall,
+        threads,
+        ..
+    } = *run;
+    let s = &p.model.scene.solver;
+    let accepted = s.max_residual.unwrap_or(s.tolerance);
+    let unconverged = match (report.unconverged_increments, report.max_final_residual) {
+        (Some(k), Some(r)) if k > 0 && r > accepted => Some(format!(
+            "{k} of {} load increments stopped at solver.max_iterations = {} with an out-of-balance force up to {r:.3e} × the reactions, above {} = {accepted:e}: the forces and the crack path are not the quasi-static answer. Raise solver.max_iterations or solver.increments, or accept the residual with solver.max_residual ≥ {r:.2e}",
+            report.increments.unwrap_or(0),
+            s.max_iterations,
+            if s.max_residual.is_some() { "solver.max_residual" } else { "solver.tolerance" },
+        )),
+        _ => None,
+    };
+    let failure = run.failure.clone();
+    let status = if failure.is_some() {
+        "unstable"
+    } else if unconverged.is_some() {
+        "unconverged"
+    } else {
+        "completed"
+    };
+    let failure = failure.or(unconverged);
+    let sign = p
+        .probe
+        .as_ref()
+        .map(|(_, pr)| if pr.amplitude < 0.0 { -1.0 } else { 1.0 })
+        .unwrap_or(1.0);
+    let peak = records.iter().max_by(|a, b| {
+        (sign * a.force_n)
+            .partial_cmp(&(sign * b.force_n))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    let last = records.last().copied().unwrap_or_default();
+    let umax = records.iter().map(|r| r.internal_j).fold(0.0, f64::max);
+    let ratio_over = |rs: &[Record]| {
+        rs.iter()
+            .filter(|r| r.internal_j >= 0.01 * umax && umax > 0.0)
+            .map(|r| r.kinetic_j / r.internal_j)
+            .fold(0.0, f64::max)
+    };
+    // Before and around the peak: the records up to the peak and after it while the force
+    // stays at 80% of the peak or more.
+    let window_end = match peak {
+        Some(pk) => {
+            let ipk = records.iter().position(|r| r.step == pk.step).unwrap_or(0);
+            records[ipk..]
+                .iter()
+                .position(|r| sign * r.force_n < 0.8 * sign * pk.force_n)
+                .map(|o| ipk + o)
+                .unwrap_or(records.len())
+        }
+        None => records.len(),
+    };
+    let ratio = ratio_over(&records[..window_end]);
+    let ratio_whole = ratio_over(records);
+    let d = &p.model.scene.discretisation;
+    Summary {
+        scene: p.model.scene.name().to_string(),
+        description: p.model.scene.description.clone(),
+        status: status.into(),
+        message: failure,
+        particles: p.model.particles.len(),
+        bonds: p.model.particles.bonds(),
+        steps: run.steps_done,
+        dt_s: p.dt,
+        dt_stable_s: p.stable.dt_stable,
+        safety: p.dt / p.stable.dt_stable,
+        fundamental_period_s: p.fundamental.period,
+        t_end_s: p.t_end,
+        wall_time_s: wall,
+        wall_time_to_peak_s: peak
+            .and_then(|pk| records.iter().position(|r| r.step == pk.step))
+            .and_then(|i| wall_s.get(i).copied())
+            .unwrap_or(wall),
+        peak_step: peak.map(|r| r.step).unwrap_or(0),
+        solver_method: method,
+        iterations: report.iterations,
+        increments: report.increments,
+        unconverged_increments: report.unconverged_increments,
+        max_final_residual: report.max_final_residual,
+        stopped_after_peak: report.stopped_after_peak,
+        threads,
+        probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),
+        peak_force_n: peak.map(|r| r.force_n * sign).unwrap_or(0.0),
+        displacement_at_peak_m: peak.map(|r| r.displacement_m).unwrap_or(0.0),
+        final_displacement_m: last.displacement_m,
+        final_force_n: last.force_n,
+        dissipated_energy_j: last.external_work_j
+            - last.kinetic_j
+            - last.internal_j
+            - last.damping_j,
+        damping_energy_j: last.damping_j,
+        external_work_j: last.external_work_j,
+        internal_energy_j: last.internal_j,
+        kinetic_energy_j: last.kinetic_j,
+        max_kinetic_to_internal_energy: ratio,
+        max_kinetic_to_internal_energy_whole_run: ratio_whole,
+        max_damage: damage.map(|d| d.iter().map(|p| p.wt).fold(0.0, f64::max)),
+        max_compressive_damage: damage.map(|d| d.iter().map(|p| p.wc).fold(0.0, f64::max)),
+        cracked_particles: damage.map(|d| d.iter().filter(|p| p.wt >= 0.99).count()),
+        crushed_particles: damage.map(|d| d.iter().filter(|p| p.wc >= 0.99).count()),
+        yielded_particles: damage.map(|d| d.iter().filter(|p| p.yielded).count()),
+        concrete: crate::model::damage::ConcreteLaw::from_scene(&p.model.scene),
+        material_values: p.model.scene.derived.clone(),
+        force_lag: p.model.scene.solver.force_lag,
+        kernel,
+        surface_correction: p.model.surface.clone(),
+        micro_modulus_a_bulk: p.model.bulk.a,
+        micro_modulus_b_bulk: p.model.bulk.b,
+        spacing_m: d.spacing,
+        rotation_deg: d.rotation_deg,
+        offset_m: d.offset,
+        omega_max_rad_s: p.stable.omega_max,
+        omega_max_bound_rad_s: p.stable.omega_max_bound,
+        seed: p.model.scene.effective_seed(),
+        random_fields: p.model.fields.iter().map(|f| f.report.clone()).collect(),
+        sppm_version: env!("CARGO_PKG_VERSION").to_string(),
+    }
+}
