@@ -102,7 +102,7 @@ pub fn bench(
             plasticity: kernel == KernelSet::Full,
             crack_band: 2.8,
         };
-        crate::solver::concrete::Concrete::<6>::new(
+        crate::solver::concrete::Concrete::<2, 6>::new(
             crate::model::two_spring::TwoSpring::new(law, None),
             &p,
         )

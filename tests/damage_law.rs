@@ -18,7 +18,7 @@ struct Brittle {
     critical: f64,
 }
 
-impl<const K: usize> DamageLaw<K> for Brittle {
+impl<const K: usize> DamageLaw<2, K> for Brittle {
     type State = bool;
 
     fn kernel(&self) -> Kernel {
@@ -35,7 +35,7 @@ impl<const K: usize> DamageLaw<K> for Brittle {
 
     fn update<const FULL: bool>(
         &self,
-        b: &ParticleBonds<'_, K>,
+        b: &ParticleBonds<'_, 2, K>,
         failed: &mut bool,
         _: &mut [f64; K],
     ) {
@@ -61,7 +61,7 @@ fn a_brittle_bond_law_runs_through_the_concrete_kernel() {
     assert!(sim.inelastic.is_none());
     // the plate is pulled to a strain of 1e-4: fail bonds at 0.5e-4
     let critical = 0.5e-4;
-    let law: Concrete<6, Brittle> = Concrete::new(Brittle { critical }, &p.model.particles);
+    let law: Concrete<2, 6, Brittle> = Concrete::new(Brittle { critical }, &p.model.particles);
     sim.inelastic = Some(Box::new(law));
     let probe = p.probe.as_ref().unwrap().1.clone();
     let mut peak: f64 = 0.0;

@@ -62,7 +62,7 @@ fn kernel_concrete_kernel_and_linear_operator_give_the_same_forces() {
             .collect();
         // the concrete kernel, undamaged
         let law = ConcreteLaw::from_scene(&p.model.scene).unwrap();
-        let mut c: Concrete<6> = Concrete::new(TwoSpring::new(law, None), &p.model.particles);
+        let mut c: Concrete<2, 6> = Concrete::new(TwoSpring::new(law, None), &p.model.particles);
         let f_concrete = concrete::internal_forces(m, &mut c, &x);
         let scale = f_kernel.iter().map(|f| f.norm()).fold(0.0, f64::max);
         for i in 0..n {
@@ -163,7 +163,7 @@ fn stress_recovery_is_the_same_through_both_paths() {
     let x: Vec<_> = x0.iter().zip(&u).map(|(a, b)| a + b).collect();
     let elastic = particle_stress(m, vol, &x);
     let law = ConcreteLaw::from_scene(&p.model.scene).unwrap();
-    let c: Concrete<6> = Concrete::new(TwoSpring::new(law, None), &p.model.particles);
+    let c: Concrete<2, 6> = Concrete::new(TwoSpring::new(law, None), &p.model.particles);
     let damaged = concrete::particle_stress(m, &c, &x, vol);
     let scale = elastic.iter().map(|s| s.norm()).fold(0.0, f64::max);
     assert!(scale > 0.0);

@@ -28,7 +28,7 @@
 //! Then `run` builds `solver::concrete::Concrete::<K, YourLaw>::new(law, &body)` where it
 //! builds the two-spring law today.
 
-use super::strain::StrainFit;
+use super::dimension::{Dim, Dimension};
 
 /// Which kernel a law needs (the solver's `KernelSet` without the elastic one).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,11 +62,14 @@ impl ParticleDamage {
 
 /// What the kernel hands a law about one particle's bonds at the current positions, slot by
 /// slot (0 and `used = false` in empty slots).
-pub struct ParticleBonds<'a, const K: usize> {
+pub struct ParticleBonds<'a, const D: usize, const K: usize>
+where
+    Dim<D>: Dimension<D>,
+{
     /// The particle.
     pub i: usize,
-    /// Its least-squares strain projector (`model::strain`).
-    pub fit: &'a StrainFit<K>,
+    /// Its least-squares strain projector (`model::dimension`, `Dimension::strain_fit`).
+    pub fit: &'a <Dim<D> as Dimension<D>>::StrainFit<K>,
     /// Total stretches S_T.
     pub total: &'a [f64; K],
     /// Elastic stretches S_e = S_T − S_P.
@@ -85,8 +88,12 @@ pub struct ParticleBonds<'a, const K: usize> {
     pub length: f64,
 }
 
-/// A damage law (see the module documentation for how to add one).
-pub trait DamageLaw<const K: usize>: Send + Sync + 'static {
+/// A damage law of particles in D dimensions with K bond slots (see the module documentation
+/// for how to add one).
+pub trait DamageLaw<const D: usize, const K: usize>: Send + Sync + 'static
+where
+    Dim<D>: Dimension<D>,
+{
     /// What one particle remembers; `Default` is undamaged.
     type State: Copy + Default + Send + Sync + PartialEq + std::fmt::Debug + 'static;
 
@@ -106,7 +113,7 @@ pub trait DamageLaw<const K: usize>: Send + Sync + 'static {
     /// `FULL`, the plastic stretch states `sps` (committed on entry) of particle `bonds.i`.
     fn update<const FULL: bool>(
         &self,
-        bonds: &ParticleBonds<'_, K>,
+        bonds: &ParticleBonds<'_, D, K>,
         state: &mut Self::State,
         sps: &mut [f64; K],
     );

@@ -110,7 +110,13 @@ pub trait Dimension<const D: usize>: Copy + Default + Debug + Send + Sync + 'sta
     /// A Voigt vector (`Vector3` in 2D, `Vector6` in 3D).
     type Voigt: Copy + Debug + PartialEq + Send + Sync + 'static;
     /// A V×V matrix in Voigt notation: elasticity D, stiffness bases A, B, C.
-    type Stiffness: Copy + Debug + PartialEq + Send + Sync + 'static;
+    type Stiffness: Copy
+        + Debug
+        + PartialEq
+        + Send
+        + Sync
+        + 'static
+        + std::ops::Mul<f64, Output = Self::Stiffness>;
     /// Rows of a particle's least-squares strain projector for K slots, V×K
     /// (`[[f64; K]; V]`).
     type StrainFit<const K: usize>: Copy + Debug + PartialEq + Send + Sync + 'static;

@@ -11,35 +11,43 @@
 
 use super::damage::{self, ConcreteLaw, LocalProperties};
 use super::damage_law::{DamageLaw, Kernel, ParticleBonds, ParticleDamage};
+use super::dimension::{Dim, Dimension};
 use super::force_state::force_state;
-use super::micro_modulus::elasticity_matrix;
 use super::plasticity;
-use super::strain;
-use nalgebra::{Matrix2, Matrix3, Vector3};
 
-/// The two-spring law of a run: the concrete law, its elasticity matrix and, with random
-/// fields, each particle's own E, f't, f'c and G_f.
+/// The two-spring law of a run in D dimensions (2D plane stress or strain by the law's
+/// `plane`, or 3D): the concrete law, its elasticity matrix and, with random fields, each
+/// particle's own E, f't, f'c and G_f.
 #[derive(Clone, Debug)]
-pub struct TwoSpring {
+pub struct TwoSpring<const D: usize>
+where
+    Dim<D>: Dimension<D>,
+{
     pub law: ConcreteLaw,
     /// Elasticity matrix D of the law (Voigt, engineering shear).
-    pub d: Matrix3<f64>,
+    pub d: <Dim<D> as Dimension<D>>::Stiffness,
     /// Each particle's own values (random fields, MODEL.md §12); `None`: the law's values
     /// everywhere.
     pub local: Option<Vec<LocalProperties>>,
 }
 
-impl TwoSpring {
+impl<const D: usize> TwoSpring<D>
+where
+    Dim<D>: Dimension<D>,
+{
     pub fn new(law: ConcreteLaw, local: Option<Vec<LocalProperties>>) -> Self {
         TwoSpring {
             law,
-            d: elasticity_matrix(law.e, law.nu, law.plane),
+            d: Dim::<D>::elasticity(law.e, law.nu, law.plane),
             local,
         }
     }
 }
 
-impl<const K: usize> DamageLaw<K> for TwoSpring {
+impl<const D: usize, const K: usize> DamageLaw<D, K> for TwoSpring<D>
+where
+    Dim<D>: Dimension<D>,
+{
     type State = ParticleDamage;
 
     /// The tension kernel unless the law has compressive damage or plasticity
@@ -84,7 +92,7 @@ impl<const K: usize> DamageLaw<K> for TwoSpring {
     #[inline(always)]
     fn update<const FULL: bool>(
         &self,
-        b: &ParticleBonds<'_, K>,
+        b: &ParticleBonds<'_, D, K>,
         p: &mut ParticleDamage,
         sps: &mut [f64; K],
     ) {
@@ -101,31 +109,30 @@ impl<const K: usize> DamageLaw<K> for TwoSpring {
         };
         // Strains (§7): total for the damage law and ε_eff; the criteria stress from the
         // damaged elastic stretches.
-        let eps = strain::strain_tensor(b.fit, b.total);
+        let eps = Dim::<D>::strain_tensor(b.fit, b.total);
         // The criteria stress D·ε_d, needed only to test initiation and yield.
         let criteria_stress = || {
             let eps_d = if b.undamaged {
                 eps
             } else {
-                strain::strain_tensor(b.fit, b.damaged)
+                Dim::<D>::strain_tensor(b.fit, b.damaged)
             };
             // D is linear in E: a particle's own E scales the law's D.
-            let sv = (self.d * (law.e / self.law.e))
-                * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
-            Matrix2::new(sv[0], sv[2], sv[2], sv[1])
+            Dim::<D>::stress_of_strain(&(self.d * (law.e / self.law.e)), &eps_d)
         };
 
         // Tensile damage (§8).
         let mut initiates_now = false;
         if law.tensile_damage && !p.initiated {
-            let (s1, s2) = strain::principal_values(&criteria_stress());
-            let s33 = plasticity::out_of_plane_stress(s1, s2, law.nu, law.plane);
-            initiates_now = damage::initiates(law, s1.max(s33), s2.min(s33));
+            // σ_max, σ_min, with the out-of-plane σ_zz in 2D
+            let (hi, lo) =
+                Dim::<D>::principal_stress_extremes(&criteria_stress(), law.nu, law.plane);
+            initiates_now = damage::initiates(law, hi, lo);
         }
         if !(FULL || p.initiated || initiates_now) {
             return;
         }
-        let (e1, e2, e3) = strain::principal_strains(&eps, law.nu, law.plane);
+        let (e1, e2, e3) = Dim::<D>::principal_strains(&eps, law.nu, law.plane);
         if initiates_now {
             p.initiated = true;
             p.eps_init = e1;
@@ -145,7 +152,7 @@ impl<const K: usize> DamageLaw<K> for TwoSpring {
             if law.plasticity && p.wc < 1.0 {
                 let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
                 let ratio =
-                    plasticity::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
+                    Dim::<D>::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
                 if ratio >= 1.0 {
                     let mut fs = [0.0; K];
                     for k in 0..K {

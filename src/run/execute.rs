@@ -76,7 +76,7 @@ pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
     );
     if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
         let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
-        let c: Concrete<6> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
+        let c: Concrete<2, 6> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
         sim.inelastic = Some(Box::new(c));
     }
     sim

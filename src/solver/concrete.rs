@@ -37,23 +37,26 @@ use super::KernelSet;
 use crate::discretise::{Particles, NONE};
 pub use crate::model::damage_law::ParticleDamage;
 use crate::model::damage_law::{DamageLaw, Kernel, ParticleBonds};
+use crate::model::dimension::{Dim, Dimension};
 use crate::model::force_state::{
     bond_energy, damaged_axial, damaged_bond_force, damaged_force_state, dilatation_term,
 };
-use crate::model::strain::{self, StrainFit};
 use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
-use nalgebra::{Matrix2, Vector2};
+use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
 
 /// Damage and plasticity of a run: the law, the per-particle geometry the kernel needs, and
 /// the committed and trial state.
 #[derive(Clone, Debug)]
-pub struct Concrete<const K: usize, L: DamageLaw<K> = TwoSpring> {
+pub struct Concrete<const D: usize, const K: usize, L: DamageLaw<D, K> = TwoSpring<D>>
+where
+    Dim<D>: Dimension<D>,
+{
     pub law: L,
     /// Least-squares strain projector of each particle (reference bond directions).
-    pub fit: Vec<StrainFit<K>>,
+    pub fit: Vec<<Dim<D> as Dimension<D>>::StrainFit<K>>,
     pub reverse: Vec<[u8; K]>,
     /// Each particle's length scale L0,i (m; the body's `length`).
     pub length: Vec<f64>,
@@ -64,15 +67,18 @@ pub struct Concrete<const K: usize, L: DamageLaw<K> = TwoSpring> {
     pub sps: Vec<[f64; K]>,
     sps_trial: Vec<[f64; K]>,
     /// Scratch from pass 1 for pass 2 of the same step.
-    cache: Vec<[SlotCache; K]>,
+    cache: Vec<[SlotCache<D>; K]>,
     /// Run the full kernel even where the law needs only the tension kernel (for tests that
     /// compare the two).
     pub force_full: bool,
 }
 
-impl<const K: usize, L: DamageLaw<K>> Concrete<K, L> {
+impl<const D: usize, const K: usize, L: DamageLaw<D, K>> Concrete<D, K, L>
+where
+    Dim<D>: Dimension<D>,
+{
     /// Undamaged, without plastic stretch.
-    pub fn new(law: L, p: &Particles<2, K>) -> Self {
+    pub fn new(law: L, p: &Particles<D, K>) -> Self {
         let n = p.len();
         let fit = (0..n)
             .map(|i| {
@@ -83,7 +89,7 @@ impl<const K: usize, L: DamageLaw<K>> Concrete<K, L> {
                         *d = Some((p.x0[j as usize] - p.x0[i]).normalize());
                     }
                 }
-                strain::strain_fit(&dirs)
+                Dim::<D>::strain_fit(&dirs)
             })
             .collect();
         Concrete {
@@ -124,18 +130,29 @@ impl<const K: usize, L: DamageLaw<K>> Concrete<K, L> {
 
 /// What pass 2 needs of one slot, left by pass 1 at the same positions and state: the unit
 /// vector, d·(a_i + a_j)·S_e, √d and d (0 everywhere in an empty slot).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct SlotCache {
-    e: Vector2<f64>,
+#[derive(Clone, Copy, Debug)]
+pub struct SlotCache<const D: usize> {
+    e: SVector<f64, D>,
     d_a_se: f64,
     sd: f64,
     d: f64,
 }
 
+impl<const D: usize> Default for SlotCache<D> {
+    fn default() -> Self {
+        SlotCache {
+            e: SVector::zeros(),
+            d_a_se: 0.0,
+            sd: 0.0,
+            d: 0.0,
+        }
+    }
+}
+
 /// One slot's kinematics: unit vector, total stretch, elastic stretch, damage factor.
 #[derive(Clone, Copy)]
-struct Slot {
-    e: Vector2<f64>,
+struct Slot<const D: usize> {
+    e: SVector<f64, D>,
     st: f64,
     se: f64,
     d: f64,
@@ -150,13 +167,16 @@ struct Slot {
 /// With `FULL = false` (the tension kernel: no plasticity, no compressive damage) the plastic
 /// stretch is zero, so it is not read.
 #[inline(always)]
-fn slot<const K: usize, L: DamageLaw<K>, const FULL: bool>(
-    m: &Mechanics<2, K>,
-    c: &Concrete<K, L>,
-    x: &[Vector2<f64>],
+fn slot<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
     i: usize,
     k: usize,
-) -> Option<Slot> {
+) -> Option<Slot<D>>
+where
+    Dim<D>: Dimension<D>,
+{
     let j = m.neighbours[i][k];
     if j == NONE {
         return None;
@@ -185,16 +205,19 @@ fn slot<const K: usize, L: DamageLaw<K>, const FULL: bool>(
 
 /// All slots of particle i and its damaged dilatation term bθ_i = b_i·Σ_m √d_im·S_e,im.
 #[inline(always)]
-fn slots<const K: usize, L: DamageLaw<K>, const FULL: bool>(
-    m: &Mechanics<2, K>,
-    c: &Concrete<K, L>,
-    x: &[Vector2<f64>],
+fn slots<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
     i: usize,
-) -> ([Option<Slot>; K], f64) {
+) -> ([Option<Slot<D>>; K], f64)
+where
+    Dim<D>: Dimension<D>,
+{
     let mut out = [None; K];
     let mut theta = 0.0;
     for (k, o) in out.iter_mut().enumerate() {
-        *o = slot::<K, L, FULL>(m, c, x, i, k);
+        *o = slot::<D, K, L, FULL>(m, c, x, i, k);
         if let Some(s) = o {
             theta += s.sd * s.se;
         }
@@ -207,15 +230,18 @@ fn slots<const K: usize, L: DamageLaw<K>, const FULL: bool>(
 ///
 /// `FULL = false` is the tension kernel: it reads no plastic stretch.
 #[inline]
-fn update_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
-    m: &Mechanics<2, K>,
-    c: &Concrete<K, L>,
-    x: &[Vector2<f64>],
+fn update_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
     i: usize,
     trial: &mut L::State,
     sps_trial: &mut [f64; K],
-    cache: &mut [SlotCache; K],
-) -> f64 {
+    cache: &mut [SlotCache<D>; K],
+) -> f64
+where
+    Dim<D>: Dimension<D>,
+{
     // One pass over the slots: the cache for pass 2, bθ_i, and the stretches for the strain.
     let mut st = [0.0; K];
     let mut se = [0.0; K];
@@ -227,7 +253,7 @@ fn update_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
     // stretch): one strain fit serves both.
     let mut same = true;
     for k in 0..K {
-        cache[k] = match slot::<K, L, FULL>(m, c, x, i, k) {
+        cache[k] = match slot::<D, K, L, FULL>(m, c, x, i, k) {
             Some(s) => {
                 let j = m.neighbours[i][k] as usize;
                 st[k] = s.st;
@@ -268,12 +294,14 @@ fn update_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
 }
 
 /// Pass 1 over all particles.
-fn pass_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
-    m: &Mechanics<2, K>,
-    c: &mut Concrete<K, L>,
-    x: &[Vector2<f64>],
+fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
+    m: &Mechanics<D, K>,
+    c: &mut Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
     b_theta: &mut [f64],
-) {
+) where
+    Dim<D>: Dimension<D>,
+{
     let mut trial = std::mem::take(&mut c.trial);
     let mut sps_trial = std::mem::take(&mut c.sps_trial);
     let mut cache = std::mem::take(&mut c.cache);
@@ -287,7 +315,7 @@ fn pass_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, (((bt, tr), sp), ca))| {
-                *bt = update_state::<K, L, FULL>(m, c, x, i, tr, sp, ca)
+                *bt = update_state::<D, K, L, FULL>(m, c, x, i, tr, sp, ca)
             });
     }
     c.trial = trial;
@@ -298,14 +326,17 @@ fn pass_state<const K: usize, L: DamageLaw<K>, const FULL: bool>(
 /// Internal force on particle i and the power of its bond dampers (half of each bond's),
 /// from the slot cache pass 1 left and every particle's bθ.
 #[inline]
-fn particle_force<const K: usize, L: DamageLaw<K>, const DAMP: bool>(
-    m: &Mechanics<2, K>,
-    c: &Concrete<K, L>,
-    v: &[Vector2<f64>],
+fn particle_force<const D: usize, const K: usize, L: DamageLaw<D, K>, const DAMP: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    v: &[SVector<f64, D>],
     b_theta: &[f64],
     i: usize,
-) -> (Vector2<f64>, f64) {
-    let mut f = Vector2::zeros();
+) -> (SVector<f64, D>, f64)
+where
+    Dim<D>: Dimension<D>,
+{
+    let mut f = SVector::<f64, D>::zeros();
     let mut power = 0.0;
     for (s, &j) in c.cache[i].iter().zip(&m.neighbours[i]) {
         if s.d == 0.0 {
@@ -330,19 +361,22 @@ fn particle_force<const K: usize, L: DamageLaw<K>, const DAMP: bool>(
 /// (reading A of MODEL.md §4; `force_prev` holds it). `FULL = false` is the tension kernel
 /// (see [`update_state`]), valid only for a law that needs no more ([`Kernel::Tension`]).
 pub fn step<
+    const D: usize,
     const K: usize,
-    L: DamageLaw<K>,
+    L: DamageLaw<D, K>,
     const LAG: bool,
     const DAMP: bool,
     const FULL: bool,
 >(
-    m: &Mechanics<2, K>,
-    c: &mut Concrete<K, L>,
-    st: &mut super::kernel::State<2>,
+    m: &Mechanics<D, K>,
+    c: &mut Concrete<D, K, L>,
+    st: &mut super::kernel::State<D>,
     dt: f64,
-) {
+) where
+    Dim<D>: Dimension<D>,
+{
     debug_assert!(FULL || c.kernel() == KernelSet::Tension);
-    pass_state::<K, L, FULL>(m, c, &st.x, &mut st.b_theta);
+    pass_state::<D, K, L, FULL>(m, c, &st.x, &mut st.b_theta);
     {
         let c = &*c;
         let (x, v, bt, fp) = (&st.x[..], &st.v[..], &st.b_theta[..], &st.force_prev[..]);
@@ -354,10 +388,10 @@ pub fn step<
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, (((xn, vn), fo), dw))| {
-                let (f, bond_power) = particle_force::<K, L, DAMP>(m, c, v, bt, i);
+                let (f, bond_power) = particle_force::<D, K, L, DAMP>(m, c, v, bt, i);
                 *fo = f;
                 let drive = if LAG { fp[i] } else { f };
-                central_difference::<2, K, DAMP>(
+                central_difference::<D, K, DAMP>(
                     m, i, x[i], v[i], drive, bond_power, dt, xn, vn, dw,
                 );
             });
@@ -367,19 +401,22 @@ pub fn step<
 
 /// Internal forces (bonds only, no dampers) at positions x with the committed state; the
 /// trial state is left as the step would compute it. For tests and post-processing.
-pub fn internal_forces<const K: usize, L: DamageLaw<K>>(
-    m: &Mechanics<2, K>,
-    c: &mut Concrete<K, L>,
-    x: &[Vector2<f64>],
-) -> Vec<Vector2<f64>> {
+pub fn internal_forces<const D: usize, const K: usize, L: DamageLaw<D, K>>(
+    m: &Mechanics<D, K>,
+    c: &mut Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
+) -> Vec<SVector<f64, D>>
+where
+    Dim<D>: Dimension<D>,
+{
     let mut bt = vec![0.0; x.len()];
     match c.kernel() {
-        KernelSet::Tension => pass_state::<K, L, false>(m, c, x, &mut bt),
-        _ => pass_state::<K, L, true>(m, c, x, &mut bt),
+        KernelSet::Tension => pass_state::<D, K, L, false>(m, c, x, &mut bt),
+        _ => pass_state::<D, K, L, true>(m, c, x, &mut bt),
     }
     let c = &*c;
     (0..x.len())
-        .map(|i| particle_force::<K, L, false>(m, c, x, &bt, i).0)
+        .map(|i| particle_force::<D, K, L, false>(m, c, x, &bt, i).0)
         .collect()
 }
 
@@ -391,16 +428,19 @@ pub fn internal_forces<const K: usize, L: DamageLaw<K>>(
 /// sum does not depend on the thread count or the scheduling (a parallel reduction's tree
 /// does: rayon splits work where threads steal it, and the old `par_iter().sum()` gave
 /// dissipated energies that differed in the last bits from run to run).
-pub fn internal_energy<const K: usize, L: DamageLaw<K>>(
-    m: &Mechanics<2, K>,
-    c: &Concrete<K, L>,
-    x: &[Vector2<f64>],
-) -> f64 {
+pub fn internal_energy<const D: usize, const K: usize, L: DamageLaw<D, K>>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
+) -> f64
+where
+    Dim<D>: Dimension<D>,
+{
     let per_particle: Vec<f64> = (0..x.len())
         .into_par_iter()
         .with_min_len(256)
         .map(|i| {
-            let (sl, bt) = slots::<K, L, true>(m, c, x, i);
+            let (sl, bt) = slots::<D, K, L, true>(m, c, x, i);
             let mut u = 0.0;
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
@@ -416,16 +456,19 @@ pub fn internal_energy<const K: usize, L: DamageLaw<K>>(
 
 /// Particle stresses (3.18) of particles of volume ΔV with the damaged force states
 /// F_s,ij = d_ij·a_i·S_e,ij + √d_ij·bθ_i.
-pub fn particle_stress<const K: usize, L: DamageLaw<K>>(
-    m: &Mechanics<2, K>,
-    c: &Concrete<K, L>,
-    x: &[Vector2<f64>],
+pub fn particle_stress<const D: usize, const K: usize, L: DamageLaw<D, K>>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
     volume: &[f64],
-) -> Vec<Matrix2<f64>> {
+) -> Vec<SMatrix<f64, D, D>>
+where
+    Dim<D>: Dimension<D>,
+{
     (0..x.len())
         .map(|i| {
-            let (sl, bt) = slots::<K, L, true>(m, c, x, i);
-            let mut acc = StressSum::default();
+            let (sl, bt) = slots::<D, K, L, true>(m, c, x, i);
+            let mut acc = StressSum::<D>::default();
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
                     acc.add(
@@ -472,28 +515,31 @@ pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
     fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
 }
 
-impl<const K: usize, L: DamageLaw<K>> Inelastic<2, K> for Concrete<K, L> {
+impl<const D: usize, const K: usize, L: DamageLaw<D, K>> Inelastic<D, K> for Concrete<D, K, L>
+where
+    Dim<D>: Dimension<D>,
+{
     fn step(
         &mut self,
-        m: &Mechanics<2, K>,
-        st: &mut super::kernel::State<2>,
+        m: &Mechanics<D, K>,
+        st: &mut super::kernel::State<D>,
         dt: f64,
         lag: bool,
         damp: bool,
     ) {
         let full = self.kernel() == KernelSet::Full;
         match (lag, damp, full) {
-            (false, false, false) => step::<K, L, false, false, false>(m, self, st, dt),
-            (false, true, false) => step::<K, L, false, true, false>(m, self, st, dt),
-            (true, false, false) => step::<K, L, true, false, false>(m, self, st, dt),
-            (true, true, false) => step::<K, L, true, true, false>(m, self, st, dt),
-            (false, false, true) => step::<K, L, false, false, true>(m, self, st, dt),
-            (false, true, true) => step::<K, L, false, true, true>(m, self, st, dt),
-            (true, false, true) => step::<K, L, true, false, true>(m, self, st, dt),
-            (true, true, true) => step::<K, L, true, true, true>(m, self, st, dt),
+            (false, false, false) => step::<D, K, L, false, false, false>(m, self, st, dt),
+            (false, true, false) => step::<D, K, L, false, true, false>(m, self, st, dt),
+            (true, false, false) => step::<D, K, L, true, false, false>(m, self, st, dt),
+            (true, true, false) => step::<D, K, L, true, true, false>(m, self, st, dt),
+            (false, false, true) => step::<D, K, L, false, false, true>(m, self, st, dt),
+            (false, true, true) => step::<D, K, L, false, true, true>(m, self, st, dt),
+            (true, false, true) => step::<D, K, L, true, false, true>(m, self, st, dt),
+            (true, true, true) => step::<D, K, L, true, true, true>(m, self, st, dt),
         }
     }
-    fn internal_energy(&self, m: &Mechanics<2, K>, x: &[Vector2<f64>]) -> f64 {
+    fn internal_energy(&self, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) -> f64 {
         internal_energy(m, self, x)
     }
     fn kernel(&self) -> KernelSet {
@@ -507,10 +553,10 @@ impl<const K: usize, L: DamageLaw<K>> Inelastic<2, K> for Concrete<K, L> {
     }
     fn particle_stress(
         &self,
-        m: &Mechanics<2, K>,
-        x: &[Vector2<f64>],
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
         volume: &[f64],
-    ) -> Vec<Matrix2<f64>> {
+    ) -> Vec<SMatrix<f64, D, D>> {
         particle_stress(m, self, x, volume)
     }
     fn as_any(&self) -> &dyn std::any::Any {
@@ -521,14 +567,17 @@ impl<const K: usize, L: DamageLaw<K>> Inelastic<2, K> for Concrete<K, L> {
     }
 }
 
-impl<const K: usize> dyn Inelastic<2, K> {
+impl<const D: usize, const K: usize> dyn Inelastic<D, K>
+where
+    Dim<D>: Dimension<D>,
+{
     /// The two-spring concrete model, if this is one (for tests that reach into its state).
-    pub fn concrete(&self) -> Option<&Concrete<K>> {
+    pub fn concrete(&self) -> Option<&Concrete<D, K>> {
         self.as_any().downcast_ref()
     }
 
     /// [`Self::concrete`], mutable.
-    pub fn concrete_mut(&mut self) -> Option<&mut Concrete<K>> {
+    pub fn concrete_mut(&mut self) -> Option<&mut Concrete<D, K>> {
         self.as_any_mut().downcast_mut()
     }
 }
