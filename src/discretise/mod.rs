@@ -4,6 +4,7 @@
 //! One container serves every dimension `D` and slot count `K` (6 for the 2D hexagonal
 //! lattice, 18 for 3D FCC and SPPM): an empty slot holds [`NONE`].
 
+pub mod csr;
 pub mod groups;
 pub mod hex;
 
