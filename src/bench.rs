@@ -1,12 +1,15 @@
 //! `sppm bench`: throughput of the step kernels (elastic; tension: tensile damage only; full:
 //! two-spring damage and plasticity) on a square block of hexagonal lattice, in particle-steps
-//! per second (set-up excluded).
+//! per second (set-up excluded). The elastic kernel runs on either bond layout: the fixed
+//! slots of the lattice (`solver::kernel`) or compressed sparse rows (`solver::csr_kernel`).
 
+use crate::discretise::csr::Csr;
 use crate::discretise::hex::HexLattice;
 use crate::geometry::Shape2;
 use crate::model::micro_modulus;
 use crate::scene::Plane;
 use crate::solver::concrete::Inelastic;
+use crate::solver::csr_kernel;
 use crate::solver::kernel::{self, State};
 use crate::solver::mechanics::Mechanics;
 use crate::solver::KernelSet;
@@ -21,8 +24,38 @@ pub struct BenchResult {
     pub steps: usize,
     pub threads: usize,
     pub model: String,
+    /// Bond layout: "slots" or "csr".
+    pub layout: String,
     pub particle_steps_per_s: f64,
     pub seconds: f64,
+}
+
+/// Bond layout of a benchmark.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// K fixed neighbour slots per particle (`discretise::Particles`, `solver::kernel`).
+    Slots,
+    /// Compressed sparse rows (`discretise::csr::Csr`, `solver::csr_kernel`): elastic only.
+    Csr,
+}
+
+impl Layout {
+    /// The value of `--layout`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::Slots => "slots",
+            Layout::Csr => "csr",
+        }
+    }
+
+    /// Parse `--layout`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "slots" => Some(Layout::Slots),
+            "csr" => Some(Layout::Csr),
+            _ => None,
+        }
+    }
 }
 
 /// Bytes per particle a benchmark of `kernel` allocates: the run's arrays
@@ -37,7 +70,8 @@ pub fn bytes_per_particle(kernel: KernelSet) -> usize {
 }
 
 /// Time `steps` steps of `kernel` (bond dampers on, as in the shipped scenes) on a square
-/// block of about `particles` particles on `threads` threads. The tension and full kernels
+/// block of about `particles` particles on `threads` threads, with the bonds in `layout`
+/// (the CSR layout runs the elastic kernel only). The tension and full kernels
 /// run the Table 1 concrete of 002, strained to 90% of f't/E so that every particle
 /// evaluates its criteria (and, with the full kernel, the yield test) in every step.
 pub fn bench(
@@ -45,7 +79,14 @@ pub fn bench(
     steps: usize,
     threads: usize,
     kernel: KernelSet,
+    layout: Layout,
 ) -> anyhow::Result<BenchResult> {
+    anyhow::ensure!(
+        layout == Layout::Slots || kernel == KernelSet::Elastic,
+        "--layout {}: the {} kernel runs on \"slots\" only; \"csr\" runs --model elastic",
+        layout.name(),
+        kernel.name()
+    );
     let concrete = kernel != KernelSet::Elastic;
     let l0 = 1e-3;
     let side = (particles as f64 * 0.5 * 3f64.sqrt()).sqrt() * l0;
@@ -112,10 +153,15 @@ pub fn bench(
         chosen == kernel,
         "the law chose the {chosen:?} kernel, not {kernel:?}"
     );
+    let csr = match layout {
+        Layout::Csr => Some(Csr::from_slots(&p).map_err(|e| anyhow::anyhow!("CSR bonds: {e}"))?),
+        Layout::Slots => None,
+    };
     let mut one_step = |st: &mut State<2>| {
-        match model.as_mut() {
-            Some(c) => c.step(&mech, st, dt, false, true),
-            None => kernel::step::<2, 6, false, true>(&mech, st, dt),
+        match (model.as_mut(), &csr) {
+            (Some(c), _) => c.step(&mech, st, dt, false, true),
+            (None, Some(csr)) => csr_kernel::step::<2, 6, false, true>(csr, &mech, st, dt),
+            (None, None) => kernel::step::<2, 6, false, true>(&mech, st, dt),
         }
         std::mem::swap(&mut st.x, &mut st.x_next);
         std::mem::swap(&mut st.v, &mut st.v_next);
@@ -138,6 +184,7 @@ pub fn bench(
         steps,
         threads,
         model: kernel.name().into(),
+        layout: layout.name().into(),
         particle_steps_per_s: (n * steps) as f64 / seconds,
         seconds,
     })

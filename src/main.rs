@@ -58,6 +58,10 @@ enum Command {
         /// plasticity; "concrete" is accepted for it).
         #[arg(long, default_value = "elastic")]
         model: String,
+        /// Bond layout: "slots" (fixed neighbour slots) or "csr" (compressed sparse rows;
+        /// --model elastic only).
+        #[arg(long, default_value = "slots")]
+        layout: String,
     },
     /// Many runs of one scene: lattice objectivity, convergence with the spacing, Monte Carlo
     /// size effect (and the merge of its shards).
@@ -234,6 +238,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             steps,
             threads,
             model,
+            layout,
         } => {
             anyhow::ensure!(
                 dim == 2,
@@ -247,6 +252,16 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     "--model {model}: \"elastic\", \"tension\" (tensile damage only) or \"full\" (damage and plasticity)"
                 ),
             };
+            let layout = sppm::bench::Layout::parse(&layout).ok_or_else(|| {
+                anyhow::anyhow!("--layout {layout}: \"slots\" or \"csr\" (elastic only)")
+            })?;
+            anyhow::ensure!(
+                layout == sppm::bench::Layout::Slots
+                    || kernel == sppm::solver::KernelSet::Elastic,
+                "--layout {}: runs --model elastic only, not --model {model}; use --layout slots for the {} kernel",
+                layout.name(),
+                kernel.name()
+            );
             anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
             sppm::limits::check_count(
                 "--particles",
@@ -259,7 +274,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 threads <= 4096,
                 "--threads {threads}: at most 4096 worker threads"
             );
-            let r = sppm::bench::bench(particles, steps.max(1), threads, kernel)
+            let r = sppm::bench::bench(particles, steps.max(1), threads, kernel, layout)
                 .context("benchmark failed")?;
             say!("{}", serde_json::to_string(&r)?);
             Ok(ExitCode::SUCCESS)

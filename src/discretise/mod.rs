@@ -9,6 +9,7 @@
 //! Everything downstream (micro-moduli, dampers, time step, crack band) reads a particle's
 //! own values from the body, never the scene's nominal spacing.
 
+pub mod csr;
 pub mod groups;
 pub mod hex;
 

@@ -522,7 +522,7 @@ pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
 /// per lane the same IEEE operations in the same order as the scalar code (no FMA), so the
 /// results are bit-identical to it.
 #[cfg(target_arch = "x86_64")]
-mod avx {
+pub(crate) mod avx {
     use super::{bond_cache_at, ChunkOut, Inputs, Mechanics, LANES};
     use crate::discretise::NONE;
     use core::arch::x86_64::*;
@@ -536,7 +536,10 @@ mod avx {
     /// AVX available; i0 + 4 ≤ x.len().
     #[target_feature(enable = "avx")]
     #[inline]
-    unsafe fn load_own<const D: usize>(x: &[SVector<f64, D>], i0: usize) -> [__m256d; D] {
+    pub(crate) unsafe fn load_own<const D: usize>(
+        x: &[SVector<f64, D>],
+        i0: usize,
+    ) -> [__m256d; D] {
         let mut out = [_mm256_setzero_pd(); D];
         if D == 2 && std::mem::size_of::<SVector<f64, D>>() == 16 {
             let p = x.as_ptr().add(i0) as *const f64;
@@ -565,7 +568,10 @@ mod avx {
     /// AVX available; every j < x.len().
     #[target_feature(enable = "avx")]
     #[inline]
-    unsafe fn gather_vec<const D: usize>(x: &[SVector<f64, D>], j: &[usize; 4]) -> [__m256d; D] {
+    pub(crate) unsafe fn gather_vec<const D: usize>(
+        x: &[SVector<f64, D>],
+        j: &[usize; 4],
+    ) -> [__m256d; D] {
         let mut out = [_mm256_setzero_pd(); D];
         if D == 2 && std::mem::size_of::<SVector<f64, D>>() == 16 {
             let p = x.as_ptr() as *const f64;
@@ -590,7 +596,7 @@ mod avx {
     /// s[j[l]] per lane.
     #[target_feature(enable = "avx")]
     #[inline]
-    unsafe fn gather(s: &[f64], j: &[usize; 4]) -> __m256d {
+    pub(crate) unsafe fn gather(s: &[f64], j: &[usize; 4]) -> __m256d {
         _mm256_set_pd(
             *s.get_unchecked(j[3]),
             *s.get_unchecked(j[2]),
@@ -625,7 +631,7 @@ mod avx {
     /// d = x_j − x_i per component and |d| (components summed in order, as nalgebra does).
     #[target_feature(enable = "avx")]
     #[inline]
-    unsafe fn geometry<const D: usize>(
+    pub(crate) unsafe fn geometry<const D: usize>(
         xi: &[__m256d; D],
         xj: &[__m256d; D],
     ) -> ([__m256d; D], __m256d) {

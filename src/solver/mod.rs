@@ -2,6 +2,7 @@
 //! probes (reaction force, energies) and the stability guard (ARCHITECTURE.md, "Solver").
 
 pub mod concrete;
+pub mod csr_kernel;
 pub mod kernel;
 pub mod lanczos;
 pub mod linear;

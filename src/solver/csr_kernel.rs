@@ -1,0 +1,869 @@
+//! The explicit elastic step kernel on the CSR bond layout ([`Csr`]: a varying number of
+//! bonds per particle, MODEL.md §1), the counterpart of `solver::kernel` for the slot layout.
+//!
+//! The same two gather passes per step, parallel over fixed chunks of particles with no
+//! scatter, atomics or allocation, so results do not depend on the thread count:
+//!
+//! 1. `bθ_i = b_i·Σ_m S_im` (3.8) from the current positions, storing each bond's total
+//!    stretch S_ij (3.10) and inverse current length 1/|x_j − x_i| in a per-bond cache;
+//! 2. for each particle, over its own bonds: the bond force
+//!    F_b,ij = ½((a_i + a_j)·S_ij + bθ_i + bθ_j) (3.7, 3.8) along e_ij (stretch and 1/length
+//!    from the cache), plus the bond damper (3.55), then central differences (3.58) with the
+//!    particle damper (3.56) taken semi-implicitly (`solver::kernel::central_difference`).
+//!
+//! The scalar path takes the force law from `model::force_state` and `model::stretch`; the
+//! AVX path below performs the same operations lane by lane. Per-particle data
+//! (a_i, b_i, masses, damper coefficients) are borrowed from a [`Mechanics`]; its slot arrays
+//! are not read, so a body of random particles can pass a `Mechanics<D, 0>`.
+//!
+//! Both passes have an explicit AVX path (`mod avx`, chosen at run time, no FMA) that treats
+//! four consecutive particles at once, one per lane, bond k of each lane together up to the
+//! largest bond count of the four: the slot kernel's scheme with "slot k" read as "bond k",
+//! and its loads and gathers. A lane past its own count keeps its sums (a blend, not an added
+//! zero). Per lane it performs the scalar code's IEEE operations in the same order, so its
+//! results are bit-identical to the scalar path ([`particle_force`]), which serves chunk
+//! tails, CPUs without AVX and other architectures (checked by the test at the end of this
+//! file, with bond counts from 0 to 12).
+//!
+//! Each particle sums over its bonds in flat order. Built with [`Csr::from_slots`], that is
+//! slot order, and every bond performs the IEEE operations of the slot kernel's scalar path
+//! (`solver::kernel::particle_force`) in the same order, so the results are bit-identical to
+//! the slot kernel's (whose AVX path is tested bit-identical to its scalar path):
+//! `tests/csr_layout.rs` checks this over 1,000 steps.
+//!
+//! `LAG = true` is reading (A) of MODEL.md §4: the force from the previous step's positions
+//! drives this step.
+
+use super::kernel::{central_difference, chunk_len, State};
+use super::mechanics::Mechanics;
+use crate::discretise::csr::Csr;
+use crate::model::force_state::{bond_force, dilatation_term};
+use crate::model::stretch::total_stretch;
+use nalgebra::SVector;
+use rayon::prelude::*;
+
+/// Particles treated together, one per lane. [`chunk_len`] is a multiple of it.
+pub const LANES: usize = 4;
+
+/// Length of the bond cache (`State::bond_cache`) the CSR [`step`] uses: the stretch and the
+/// inverse current length of every directed bond, interleaved.
+pub fn bond_cache_len(csr: &Csr) -> usize {
+    2 * csr.neighbours().len()
+}
+
+/// Bytes per particle-step the elastic CSR [`step`] streams in dimension `d` with bond
+/// dampers, for `bonds` directed bonds per particle: each array read or written once per pass
+/// that touches it, neighbours' data assumed in cache, write-allocate not counted. Pass 1
+/// reads the offset (4), x_i (8d) and b_i (8) and writes bθ_i (8); per bond it reads j (4)
+/// and 1/L0 (8) and writes the cache (16). Pass 2 reads the offset (4), x_i and v_i (16d),
+/// a_i, bθ_i, c_in,i, c_ex,i and 1/m_i (40), writes x, v and F (24d) and reads and writes the
+/// damper work (16); per bond it reads j (4) and the cache (16), not 1/L0. In 2D with six
+/// bonds: 36 + 168 + 140 + 120 = 464 B (the slot kernel, counted alike: 508 B, as it reads
+/// its 6 neighbour and 1/L0 slots in both passes).
+pub const fn bytes_per_particle_step(d: usize, bonds: usize) -> usize {
+    (4 + 8 * d + 8 + 8) + bonds * (4 + 8 + 16) + (4 + 16 * d + 40 + 24 * d + 16) + bonds * (4 + 16)
+}
+
+/// Whether the CPU runs AVX (then the lane code is compiled for it).
+#[inline]
+fn use_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Check the per-particle arrays against the bonds (the gathers rely on it).
+fn check_sizes<const D: usize, const K: usize>(csr: &Csr, m: &Mechanics<D, K>, n: usize) {
+    assert!(
+        csr.len() == n && m.a.len() == n && m.b.len() == n,
+        "CSR kernel: {} particles in the bonds, {} in the state, {} in the model",
+        csr.len(),
+        n,
+        m.len()
+    );
+    assert!(m.c_in.len() == n && m.c_ex.len() == n && m.inv_mass.len() == n);
+}
+
+/// b_i·Σ_m S_im of particle i; with `CACHE`, each bond's stretch and inverse length go to
+/// `cache` (the chunk's cache, whose first bond is flat bond `first`).
+#[inline(always)]
+fn dilatation_one<const D: usize, const K: usize, const CACHE: bool>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    i: usize,
+    first: usize,
+    cache: &mut [f64],
+) -> f64 {
+    let (nb, il) = (csr.neighbours(), csr.inv_l0());
+    let xi = x[i];
+    let mut s = 0.0;
+    for b in csr.range(i) {
+        let len = (x[nb[b] as usize] - xi).norm();
+        let st = total_stretch(len, il[b]);
+        if CACHE {
+            let c = 2 * (b - first);
+            cache[c] = st;
+            cache[c + 1] = 1.0 / len;
+        }
+        s += st;
+    }
+    dilatation_term(m.b[i], s)
+}
+
+/// Pass 1 over the particles `base..base + out.len()` (with `CACHE`, storing each bond's
+/// stretch and inverse length into `cache`, the part of the bond cache of those particles):
+/// whole blocks of [`LANES`] particles on the AVX path where `avx`, the rest one at a time.
+fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    base: usize,
+    out: &mut [f64],
+    cache: &mut [f64],
+    avx: bool,
+) {
+    let end = base + out.len();
+    assert!(end <= csr.len() && csr.len() == x.len() && m.b.len() == x.len());
+    let first = csr.offsets()[base] as usize;
+    assert!(!CACHE || cache.len() == 2 * (csr.offsets()[end] as usize - first));
+    #[cfg(target_arch = "x86_64")]
+    let done = if avx {
+        let done = out.len() / LANES * LANES;
+        // SAFETY: AVX is available (`use_avx`); base + done ≤ csr.len() = x.len() = m.len()
+        // and, with CACHE, cache holds the bonds of particles base..end (asserted above);
+        // a Csr's neighbours index its particles.
+        unsafe { avx::dilatation_chunk::<D, K, CACHE>(csr, m, x, base, &mut out[..done], cache) };
+        done
+    } else {
+        0
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = {
+        let _ = avx;
+        0
+    };
+    for (o, bt) in out.iter_mut().enumerate().skip(done) {
+        *bt = dilatation_one::<D, K, CACHE>(csr, m, x, base + o, first, cache);
+    }
+}
+
+/// Pass 1 with the cache over particles `base..base + out.len()`, whose bonds' cache is
+/// `cache`; split in halves of whole chunks run with `rayon::join`, so that each chunk gets
+/// its own part of the per-bond cache without allocating the split.
+#[allow(clippy::too_many_arguments)]
+fn dilatation_split<const D: usize, const K: usize>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    base: usize,
+    chunk: usize,
+    out: &mut [f64],
+    cache: &mut [f64],
+    avx: bool,
+) {
+    let len = out.len();
+    if len > chunk {
+        let mid = len.div_ceil(chunk) / 2 * chunk;
+        let off = csr.offsets();
+        let split = 2 * (off[base + mid] - off[base]) as usize;
+        let (out_a, out_b) = out.split_at_mut(mid);
+        let (cache_a, cache_b) = cache.split_at_mut(split);
+        rayon::join(
+            || dilatation_split(csr, m, x, base, chunk, out_a, cache_a, avx),
+            || dilatation_split(csr, m, x, base + mid, chunk, out_b, cache_b, avx),
+        );
+        return;
+    }
+    dilatation_chunk::<D, K, true>(csr, m, x, base, out, cache, avx);
+}
+
+/// Pass 1: b_i·Σ_m S_im for every particle (without the cache).
+pub fn pass_dilatation<const D: usize, const K: usize>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    out: &mut [f64],
+) {
+    check_sizes(csr, m, x.len());
+    assert!(out.len() == x.len());
+    let avx = use_avx();
+    let chunk = chunk_len(out.len());
+    out.par_chunks_mut(chunk)
+        .enumerate()
+        .for_each(|(c, items)| {
+            dilatation_chunk::<D, K, false>(csr, m, x, c * chunk, items, &mut [], avx)
+        });
+}
+
+/// Internal force on particle i at positions x with velocities v (bond dampers if `DAMP`):
+/// the force and the power dissipated in its bond dampers (half of each bond's). With
+/// `CACHE`, each bond's stretch and inverse length come from `cache` (the whole bond cache,
+/// filled by pass 1 at positions x: the f64 values computed otherwise).
+#[inline(always)]
+pub fn particle_force<const D: usize, const K: usize, const DAMP: bool, const CACHE: bool>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    x: &[SVector<f64, D>],
+    v: &[SVector<f64, D>],
+    b_theta: &[f64],
+    cache: &[f64],
+    i: usize,
+) -> (SVector<f64, D>, f64) {
+    let (nb, il) = (csr.neighbours(), csr.inv_l0());
+    let xi = x[i];
+    let ai = m.a[i];
+    let bti = b_theta[i];
+    let mut f = SVector::<f64, D>::zeros();
+    let mut power = 0.0;
+    for b in csr.range(i) {
+        let j = nb[b] as usize;
+        let (xj, aj, btj) = (x[j], m.a[j], b_theta[j]);
+        let d = xj - xi;
+        let (e, s) = if CACHE {
+            (d * cache[2 * b + 1], cache[2 * b])
+        } else {
+            let len = d.norm();
+            (d * (1.0 / len), total_stretch(len, il[b]))
+        };
+        let mut fb = bond_force(ai, aj, s, bti, btj);
+        if DAMP {
+            let c = 0.5 * (m.c_in[i] + m.c_in[j]);
+            let rate = (v[j] - v[i]).dot(&e);
+            fb += c * rate;
+            power += 0.5 * c * rate * rate;
+        }
+        f += e * fb;
+    }
+    (f, power)
+}
+
+/// What pass 2 reads: the bonds, the model, the state at step n, the bond cache (with
+/// `CACHE`) and the step size.
+#[derive(Clone, Copy)]
+struct Inputs<'a, const D: usize, const K: usize> {
+    csr: &'a Csr,
+    m: &'a Mechanics<D, K>,
+    x: &'a [SVector<f64, D>],
+    v: &'a [SVector<f64, D>],
+    b_theta: &'a [f64],
+    force_prev: &'a [SVector<f64, D>],
+    cache: &'a [f64],
+    dt: f64,
+}
+
+/// What pass 2 writes for one chunk of particles.
+struct ChunkOut<'b, const D: usize> {
+    xn: &'b mut [SVector<f64, D>],
+    vn: &'b mut [SVector<f64, D>],
+    fo: &'b mut [SVector<f64, D>],
+    dw: &'b mut [f64],
+}
+
+/// Pass 2 over one chunk starting at particle `base`: whole blocks of [`LANES`] particles on
+/// the AVX path where `avx`, the rest one at a time.
+fn update_chunk<
+    const D: usize,
+    const K: usize,
+    const LAG: bool,
+    const DAMP: bool,
+    const CACHE: bool,
+>(
+    inp: Inputs<'_, D, K>,
+    base: usize,
+    out: ChunkOut<'_, D>,
+    avx: bool,
+) {
+    let Inputs {
+        csr,
+        m,
+        x,
+        v,
+        b_theta,
+        force_prev,
+        cache,
+        dt,
+    } = inp;
+    let ChunkOut { xn, vn, fo, dw } = out;
+    let len = dw.len();
+    let n = x.len();
+    assert!(base + len <= n && csr.len() == n && v.len() == n && b_theta.len() == n);
+    assert!(force_prev.len() == n && xn.len() == len && vn.len() == len && fo.len() == len);
+    assert!(!CACHE || cache.len() == bond_cache_len(csr));
+    #[cfg(target_arch = "x86_64")]
+    let done = if avx {
+        let done = len / LANES * LANES;
+        // SAFETY: AVX is available (`use_avx`); base + done ≤ n, every state array has n
+        // entries and the model too (`check_sizes`), the cache its full length (asserted
+        // above); a Csr's neighbours index its particles.
+        unsafe {
+            avx::update_chunk::<D, K, LAG, DAMP, CACHE>(
+                inp,
+                base,
+                ChunkOut {
+                    xn: &mut xn[..done],
+                    vn: &mut vn[..done],
+                    fo: &mut fo[..done],
+                    dw: &mut dw[..done],
+                },
+            )
+        };
+        done
+    } else {
+        0
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = {
+        let _ = avx;
+        0
+    };
+    for o in done..len {
+        let i = base + o;
+        let (f, power) = particle_force::<D, K, DAMP, CACHE>(csr, m, x, v, b_theta, cache, i);
+        fo[o] = f;
+        let drive = if LAG { force_prev[i] } else { f };
+        central_difference::<D, K, DAMP>(
+            m, i, x[i], v[i], drive, power, dt, &mut xn[o], &mut vn[o], &mut dw[o],
+        );
+    }
+}
+
+/// Pass 2 (with `CACHE`, reading the cache pass 1 left at the same positions): forces and
+/// the central-difference update of every particle into x_next, v_next.
+fn pass_update_impl<
+    const D: usize,
+    const K: usize,
+    const LAG: bool,
+    const DAMP: bool,
+    const CACHE: bool,
+>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    st: &mut State<D>,
+    dt: f64,
+) {
+    let State {
+        x,
+        v,
+        x_next,
+        v_next,
+        force,
+        force_prev,
+        b_theta,
+        damping_work,
+        bond_cache,
+    } = st;
+    let n = x.len();
+    check_sizes(csr, m, n);
+    assert!([
+        v.len(),
+        x_next.len(),
+        v_next.len(),
+        force.len(),
+        force_prev.len(),
+        b_theta.len(),
+        damping_work.len()
+    ]
+    .iter()
+    .all(|&l| l == n));
+    assert!(!CACHE || bond_cache.len() == bond_cache_len(csr));
+    let inp = Inputs {
+        csr,
+        m,
+        x: &x[..],
+        v: &v[..],
+        b_theta: &b_theta[..],
+        force_prev: &force_prev[..],
+        cache: &bond_cache[..],
+        dt,
+    };
+    let avx = use_avx();
+    let chunk = chunk_len(n);
+    x_next
+        .par_chunks_mut(chunk)
+        .zip(v_next.par_chunks_mut(chunk))
+        .zip(force.par_chunks_mut(chunk))
+        .zip(damping_work.par_chunks_mut(chunk))
+        .enumerate()
+        .for_each(|(c, (((xn, vn), fo), dw))| {
+            update_chunk::<D, K, LAG, DAMP, CACHE>(inp, c * chunk, ChunkOut { xn, vn, fo, dw }, avx)
+        });
+}
+
+/// Pass 2 without the bond cache: forces and the central-difference update of every
+/// particle into x_next, v_next, from bθ as [`pass_dilatation`] left it.
+pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    st: &mut State<D>,
+    dt: f64,
+) {
+    pass_update_impl::<D, K, LAG, DAMP, false>(csr, m, st, dt);
+}
+
+/// One explicit step from x^n, v^{n−½} to x^{n+1}, v^{n+½} (not yet swapped in): pass 1,
+/// which also fills the per-bond cache of stretch and inverse length, then pass 2 reading
+/// it. `st.bond_cache` is resized to [`bond_cache_len`] on the first step if it was made for
+/// another layout (`State::at_rest` sizes it for slots).
+pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
+    csr: &Csr,
+    m: &Mechanics<D, K>,
+    st: &mut State<D>,
+    dt: f64,
+) {
+    let n = st.x.len();
+    check_sizes(csr, m, n);
+    assert!(st.b_theta.len() == n);
+    let len = bond_cache_len(csr);
+    if st.bond_cache.len() != len {
+        st.bond_cache = vec![0.0; len];
+    }
+    let avx = use_avx();
+    let chunk = chunk_len(n);
+    dilatation_split(
+        csr,
+        m,
+        &st.x,
+        0,
+        chunk,
+        &mut st.b_theta,
+        &mut st.bond_cache,
+        avx,
+    );
+    pass_update_impl::<D, K, LAG, DAMP, true>(csr, m, st, dt);
+}
+
+/// Explicit AVX (4 × f64) versions of the block code, one particle per lane, bond k of the
+/// four particles at once up to the largest of their bond counts; a lane past its count
+/// keeps its sums (a blend). Per lane the same IEEE operations in the same order as the
+/// one-particle code (no FMA), so the results are bit-identical to it. The loads and
+/// gathers are those of the slot kernel (`solver::kernel::avx`).
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{ChunkOut, Csr, Inputs, Mechanics, LANES};
+    use crate::solver::kernel::avx::{gather, gather_vec, geometry, load_own};
+    use crate::solver::kernel::central_difference;
+    use core::arch::x86_64::*;
+    use nalgebra::SVector;
+
+    const _: () = assert!(LANES == 4);
+
+    /// Bond ranges of particles i0..i0 + LANES: first bond, bond count, largest count.
+    #[inline(always)]
+    fn lane_bonds(csr: &Csr, i0: usize) -> ([usize; LANES], [usize; LANES], usize) {
+        let off = &csr.offsets()[i0..i0 + LANES + 1];
+        let start: [usize; LANES] = std::array::from_fn(|l| off[l] as usize);
+        let count: [usize; LANES] = std::array::from_fn(|l| (off[l + 1] - off[l]) as usize);
+        let most = count.iter().copied().max().unwrap_or(0);
+        (start, count, most)
+    }
+
+    /// Bond k of particles i0..i0+4: its flat position (bond 0 past a lane's count, valid as
+    /// some lane has a bond k), its neighbour (the particle itself past the count) and the
+    /// mask of lanes that have a bond k.
+    ///
+    /// # Safety
+    /// AVX available; i0 + 4 ≤ csr.len(); some lane has a bond k.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn bond_k(
+        csr: &Csr,
+        start: &[usize; 4],
+        count: &[usize; 4],
+        i0: usize,
+        k: usize,
+    ) -> ([usize; 4], [usize; 4], __m256d) {
+        let nb = csr.neighbours();
+        let mut b = [0usize; 4];
+        let mut j = [0usize; 4];
+        let mut occ = [0i64; 4];
+        for l in 0..4 {
+            let o = k < count[l];
+            occ[l] = -(o as i64);
+            b[l] = if o { start[l] + k } else { 0 };
+            j[l] = if o {
+                *nb.get_unchecked(b[l]) as usize
+            } else {
+                i0 + l
+            };
+        }
+        let mask = _mm256_castsi256_pd(_mm256_set_epi64x(occ[3], occ[2], occ[1], occ[0]));
+        (b, j, mask)
+    }
+
+    /// 1/L0 of bonds b[0..4], one per lane.
+    ///
+    /// # Safety
+    /// AVX available; every b < the number of bonds.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn inv_l0(csr: &Csr, b: &[usize; 4]) -> __m256d {
+        gather(csr.inv_l0(), b)
+    }
+
+    /// b_i·Σ_m S_im of particles i0..i0+4 (`super::dilatation_one` per lane); with `CACHE`,
+    /// each bond's stretch and inverse length into `cache`, the bond cache from flat bond
+    /// `first` on.
+    ///
+    /// # Safety
+    /// AVX available; i0 + 4 ≤ csr.len() = x.len() = m.b.len(); with `CACHE`, cache holds
+    /// the bonds of particles i0..i0+4 from `first` on.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn dilatation_block<const D: usize, const K: usize, const CACHE: bool>(
+        csr: &Csr,
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        i0: usize,
+        first: usize,
+        cache: &mut [f64],
+    ) -> __m256d {
+        let one = _mm256_set1_pd(1.0);
+        let (start, count, most) = lane_bonds(csr, i0);
+        let xi = load_own(x, i0);
+        let mut s = _mm256_setzero_pd();
+        for k in 0..most {
+            let (b, j, occ) = bond_k(csr, &start, &count, i0, k);
+            let (_, len) = geometry(&xi, &gather_vec(x, &j));
+            // total_stretch: len·(1/L0) − 1
+            let st = _mm256_sub_pd(_mm256_mul_pd(len, inv_l0(csr, &b)), one);
+            if CACHE {
+                let rinv = _mm256_div_pd(one, len);
+                let (mut sa, mut ra) = ([0.0; 4], [0.0; 4]);
+                _mm256_storeu_pd(sa.as_mut_ptr(), st);
+                _mm256_storeu_pd(ra.as_mut_ptr(), rinv);
+                for l in 0..4 {
+                    if k < count[l] {
+                        let at = 2 * (b[l] - first);
+                        *cache.get_unchecked_mut(at) = sa[l];
+                        *cache.get_unchecked_mut(at + 1) = ra[l];
+                    }
+                }
+            }
+            s = _mm256_blendv_pd(s, _mm256_add_pd(s, st), occ);
+        }
+        // dilatation_term: b·Σ S
+        _mm256_mul_pd(_mm256_loadu_pd(m.b.as_ptr().add(i0)), s)
+    }
+
+    /// Pass 1 over whole blocks: `out` holds particles base.., a multiple of 4 of them.
+    ///
+    /// # Safety
+    /// AVX available; base + out.len() ≤ csr.len() = x.len() = m.b.len(); with `CACHE`,
+    /// cache holds the bonds of those particles from their first on.
+    #[target_feature(enable = "avx")]
+    pub unsafe fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
+        csr: &Csr,
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        base: usize,
+        out: &mut [f64],
+        cache: &mut [f64],
+    ) {
+        let first = *csr.offsets().get_unchecked(base) as usize;
+        for o in (0..out.len()).step_by(4) {
+            let r = dilatation_block::<D, K, CACHE>(csr, m, x, base + o, first, cache);
+            _mm256_storeu_pd(out.as_mut_ptr().add(o), r);
+        }
+    }
+
+    /// `super::particle_force` of particles i0..i0+4, one per lane, as SoA: the force per
+    /// component and the bond-damper power.
+    ///
+    /// # Safety
+    /// AVX available; i0 + 4 ≤ csr.len(); x, v, b_theta and the model have csr.len()
+    /// entries; with `CACHE`, cache is the whole bond cache, filled by pass 1 at positions x.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    unsafe fn force_block<const D: usize, const K: usize, const DAMP: bool, const CACHE: bool>(
+        csr: &Csr,
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        v: &[SVector<f64, D>],
+        b_theta: &[f64],
+        cache: &[f64],
+        i0: usize,
+    ) -> ([__m256d; D], __m256d) {
+        let one = _mm256_set1_pd(1.0);
+        let half = _mm256_set1_pd(0.5);
+        let (start, count, most) = lane_bonds(csr, i0);
+        let xi = load_own(x, i0);
+        let vi = if DAMP {
+            load_own(v, i0)
+        } else {
+            [_mm256_setzero_pd(); D]
+        };
+        let ai = _mm256_loadu_pd(m.a.as_ptr().add(i0));
+        let bti = _mm256_loadu_pd(b_theta.as_ptr().add(i0));
+        let ci = if DAMP {
+            _mm256_loadu_pd(m.c_in.as_ptr().add(i0))
+        } else {
+            _mm256_setzero_pd()
+        };
+        let mut f = [_mm256_setzero_pd(); D];
+        let mut power = _mm256_setzero_pd();
+        for k in 0..most {
+            let (b, j, occ) = bond_k(csr, &start, &count, i0, k);
+            let xj = gather_vec(x, &j);
+            let mut d = [_mm256_setzero_pd(); D];
+            for c in 0..D {
+                d[c] = _mm256_sub_pd(xj[c], xi[c]);
+            }
+            let (rinv, st) = if CACHE {
+                // the (S, 1/len) pairs of the four bonds, transposed
+                let p = cache.as_ptr();
+                let r = |l: usize| _mm_loadu_pd(p.add(2 * b[l]));
+                let lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(0)), r(2), 1);
+                let hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(1)), r(3), 1);
+                (_mm256_unpackhi_pd(lo, hi), _mm256_unpacklo_pd(lo, hi))
+            } else {
+                let (_, len) = geometry(&xi, &xj);
+                let st = _mm256_sub_pd(_mm256_mul_pd(len, inv_l0(csr, &b)), one);
+                (_mm256_div_pd(one, len), st)
+            };
+            let aj = gather(&m.a, &j);
+            let btj = gather(b_theta, &j);
+            // bond_force: 0.5 * ((ai + aj) * s + bti + btj)
+            let mut fb = _mm256_mul_pd(
+                half,
+                _mm256_add_pd(
+                    _mm256_add_pd(_mm256_mul_pd(_mm256_add_pd(ai, aj), st), bti),
+                    btj,
+                ),
+            );
+            let mut e = [_mm256_setzero_pd(); D];
+            for c in 0..D {
+                e[c] = _mm256_mul_pd(d[c], rinv);
+            }
+            if DAMP {
+                let cj = gather(&m.c_in, &j);
+                let c = _mm256_mul_pd(half, _mm256_add_pd(ci, cj));
+                let vj = gather_vec(v, &j);
+                let mut rate = _mm256_mul_pd(_mm256_sub_pd(vj[0], vi[0]), e[0]);
+                for cc in 1..D {
+                    rate = _mm256_add_pd(rate, _mm256_mul_pd(_mm256_sub_pd(vj[cc], vi[cc]), e[cc]));
+                }
+                fb = _mm256_add_pd(fb, _mm256_mul_pd(c, rate));
+                // 0.5 * c * rate * rate
+                let p = _mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(half, c), rate), rate);
+                power = _mm256_blendv_pd(power, _mm256_add_pd(power, p), occ);
+            }
+            for c in 0..D {
+                let g = _mm256_add_pd(f[c], _mm256_mul_pd(e[c], fb));
+                f[c] = _mm256_blendv_pd(f[c], g, occ);
+            }
+        }
+        (f, power)
+    }
+
+    /// Pass 2 over whole blocks: the slices hold particles base.., a multiple of 4 of them;
+    /// the central differences lane by lane (`solver::kernel::central_difference`).
+    ///
+    /// # Safety
+    /// AVX available; base + xn.len() ≤ csr.len(); x, v, b_theta, force_prev and the model
+    /// have csr.len() entries, vn, fo and dw xn.len(); with `CACHE`, cache is the whole bond
+    /// cache, filled by pass 1 at positions x.
+    #[target_feature(enable = "avx")]
+    pub(super) unsafe fn update_chunk<
+        const D: usize,
+        const K: usize,
+        const LAG: bool,
+        const DAMP: bool,
+        const CACHE: bool,
+    >(
+        inp: Inputs<'_, D, K>,
+        base: usize,
+        out: ChunkOut<'_, D>,
+    ) {
+        let Inputs {
+            csr,
+            m,
+            x,
+            v,
+            b_theta,
+            force_prev,
+            cache,
+            dt,
+        } = inp;
+        let ChunkOut { xn, vn, fo, dw } = out;
+        for o0 in (0..xn.len()).step_by(4) {
+            let i0 = base + o0;
+            let (f, power) = force_block::<D, K, DAMP, CACHE>(csr, m, x, v, b_theta, cache, i0);
+            let mut fa = [[0.0; 4]; D];
+            for c in 0..D {
+                _mm256_storeu_pd(fa[c].as_mut_ptr(), f[c]);
+            }
+            let mut pa = [0.0; 4];
+            _mm256_storeu_pd(pa.as_mut_ptr(), power);
+            for l in 0..4 {
+                let (o, i) = (o0 + l, i0 + l);
+                let fl = SVector::<f64, D>::from_fn(|c, _| fa[c][l]);
+                *fo.get_unchecked_mut(o) = fl;
+                let drive = if LAG {
+                    *force_prev.get_unchecked(i)
+                } else {
+                    fl
+                };
+                central_difference::<D, K, DAMP>(
+                    m,
+                    i,
+                    *x.get_unchecked(i),
+                    *v.get_unchecked(i),
+                    drive,
+                    pa[l],
+                    dt,
+                    xn.get_unchecked_mut(o),
+                    vn.get_unchecked_mut(o),
+                    dw.get_unchecked_mut(o),
+                );
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::kernel::CHUNK;
+
+    /// Deterministic pseudo-random numbers in [0, 1).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// Random bonds (0 to about 12 per particle, none for every 17th particle), a random
+    /// model without slots (`Mechanics<D, 0>`) and a random state; n not a multiple of the
+    /// chunk or block size.
+    fn model<const D: usize>(n: usize) -> (Csr, Mechanics<D, 0>, State<D>) {
+        let mut r = Lcg(4321);
+        let x0: Vec<SVector<f64, D>> = (0..n)
+            .map(|i| SVector::from_fn(|c, _| i as f64 * 1e-3 * (c + 1) as f64 + 1e-4 * r.next()))
+            .collect();
+        let mut pairs = Vec::new();
+        for i in (0..n).filter(|i| !i.is_multiple_of(17)) {
+            for _ in 0..(r.next() * 7.0) as usize {
+                let j = (i + 1 + (r.next() * 40.0) as usize) % n;
+                if j != i && !j.is_multiple_of(17) {
+                    pairs.push((i as u32, j as u32));
+                }
+            }
+        }
+        let csr = Csr::from_pairs(&x0, &pairs).unwrap();
+        let most = (0..n).map(|i| csr.bond_count(i)).max().unwrap();
+        assert!(most >= 10 && csr.bond_count(0) == 0, "{most}");
+        let mut v = |s: f64| (0..n).map(|_| s * (1.0 + r.next())).collect::<Vec<f64>>();
+        let (a, b, mass, c_in, mut c_ex) = (v(3e6), v(-1e5), v(1e-3), v(10.0), v(1.0));
+        for c in c_ex.iter_mut().step_by(3) {
+            *c = 0.0;
+        }
+        let mech = Mechanics {
+            neighbours: vec![[]; n],
+            inv_l0: vec![[]; n],
+            a,
+            b,
+            inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
+            mass,
+            c_in,
+            c_ex,
+        };
+        let mut st = State::at_rest(&x0);
+        for i in 0..n {
+            st.x[i] += SVector::from_fn(|_, _| 1e-6 * (r.next() - 0.5));
+            st.v[i] = SVector::from_fn(|_, _| r.next() - 0.5);
+            st.force_prev[i] = SVector::from_fn(|_, _| r.next() - 0.5);
+            st.damping_work[i] = r.next();
+        }
+        (csr, mech, st)
+    }
+
+    /// The kernel (AVX blocks where the CPU has AVX, chunk tails one at a time) against the
+    /// plain per-particle code, bit for bit, on 1 and 2 threads, with and without the cache.
+    fn check<const D: usize, const LAG: bool, const DAMP: bool>() {
+        let n = 2 * CHUNK + 4 * 37 + 3;
+        let (csr, m, st0) = model::<D>(n);
+        let dt = 1e-7;
+        let mut want = st0.clone();
+        for i in 0..n {
+            want.b_theta[i] = dilatation_one::<D, 0, false>(&csr, &m, &st0.x, i, 0, &mut []);
+        }
+        for i in 0..n {
+            let (f, p) = particle_force::<D, 0, DAMP, false>(
+                &csr,
+                &m,
+                &st0.x,
+                &st0.v,
+                &want.b_theta,
+                &[],
+                i,
+            );
+            want.force[i] = f;
+            let drive = if LAG { st0.force_prev[i] } else { f };
+            central_difference::<D, 0, DAMP>(
+                &m,
+                i,
+                st0.x[i],
+                st0.v[i],
+                drive,
+                p,
+                dt,
+                &mut want.x_next[i],
+                &mut want.v_next[i],
+                &mut want.damping_work[i],
+            );
+        }
+        let bits = |v: &[SVector<f64, D>]| {
+            v.iter()
+                .flat_map(|p| p.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
+                .collect::<Vec<_>>()
+        };
+        let sbits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for cached in [true, false] {
+                let mut st = st0.clone();
+                pool.install(|| {
+                    if cached {
+                        step::<D, 0, LAG, DAMP>(&csr, &m, &mut st, dt)
+                    } else {
+                        pass_dilatation(&csr, &m, &st.x, &mut st.b_theta);
+                        pass_update::<D, 0, LAG, DAMP>(&csr, &m, &mut st, dt)
+                    }
+                });
+                assert_eq!(sbits(&st.b_theta), sbits(&want.b_theta));
+                assert_eq!(bits(&st.force), bits(&want.force));
+                assert_eq!(bits(&st.x_next), bits(&want.x_next));
+                assert_eq!(bits(&st.v_next), bits(&want.v_next));
+                assert_eq!(sbits(&st.damping_work), sbits(&want.damping_work));
+            }
+        }
+    }
+
+    #[test]
+    fn bytes_per_particle_step_in_2d() {
+        assert_eq!(bytes_per_particle_step(2, 6), 464);
+    }
+
+    #[test]
+    fn step_matches_scalar_reference_bitwise() {
+        check::<2, false, true>();
+        check::<2, false, false>();
+        check::<2, true, true>();
+        check::<3, false, true>();
+        check::<3, true, false>();
+    }
+}
