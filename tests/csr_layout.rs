@@ -56,7 +56,10 @@ fn mechanics(p: &Particles<2, 6>) -> Mechanics<2, 6> {
             .collect::<Vec<_>>()
     };
     let (av, bv, rho) = (vary(a), vary(b), vary(2400.0));
-    let mut m = Mechanics::new(p, av, bv, &rho);
+    let mut body = p.clone();
+    body.a = av;
+    body.b = bv;
+    let mut m = Mechanics::new(&body, &rho);
     let omega = sppm::material::particle_frequency(e, nu, 2400.0, l0);
     for i in 0..n {
         m.c_in[i] = 2.0 * m.mass[i] * 0.2 * omega * (0.9 + 0.2 * r.next());
