@@ -155,9 +155,9 @@ where
                     Dim::<D>::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
                 if ratio >= 1.0 {
                     let mut fs = [0.0; K];
-                    for k in 0..K {
+                    for (k, f) in fs.iter_mut().enumerate() {
                         if b.used[k] {
-                            fs[k] = force_state(b.a, b.elastic[k], b.b_theta_elastic);
+                            *f = force_state(b.a, b.elastic[k], b.b_theta_elastic);
                         }
                     }
                     plasticity::flow(&fs, b.used, ratio, law.fy / law.e, sps);

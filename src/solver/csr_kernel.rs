@@ -34,7 +34,7 @@
 //! `LAG = true` is reading (A) of MODEL.md §4: the force from the previous step's positions
 //! drives this step.
 
-use super::kernel::{central_difference, chunk_len, State};
+use super::kernel::{central_difference, chunk_len, use_avx, ChunkOut, State};
 use super::mechanics::Mechanics;
 use crate::discretise::csr::Csr;
 use crate::model::force_state::{bond_force, dilatation_term};
@@ -62,19 +62,6 @@ pub fn bond_cache_len(csr: &Csr) -> usize {
 /// its 6 neighbour and 1/L0 slots in both passes).
 pub const fn bytes_per_particle_step(d: usize, bonds: usize) -> usize {
     (4 + 8 * d + 8 + 8) + bonds * (4 + 8 + 16) + (4 + 16 * d + 40 + 24 * d + 16) + bonds * (4 + 16)
-}
-
-/// Whether the CPU runs AVX (then the lane code is compiled for it).
-#[inline]
-fn use_avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
 }
 
 /// Check the per-particle arrays against the bonds (the gathers rely on it).
@@ -255,14 +242,6 @@ struct Inputs<'a, const D: usize, const K: usize> {
     force_prev: &'a [SVector<f64, D>],
     cache: &'a [f64],
     dt: f64,
-}
-
-/// What pass 2 writes for one chunk of particles.
-struct ChunkOut<'b, const D: usize> {
-    xn: &'b mut [SVector<f64, D>],
-    vn: &'b mut [SVector<f64, D>],
-    fo: &'b mut [SVector<f64, D>],
-    dw: &'b mut [f64],
 }
 
 /// Pass 2 over one chunk starting at particle `base`: whole blocks of [`LANES`] particles on
@@ -731,17 +710,7 @@ mod tests {
     use super::*;
     use crate::solver::kernel::CHUNK;
 
-    /// Deterministic pseudo-random numbers in [0, 1).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::solver::test_rng::Lcg;
 
     /// Random bonds (0 to about 12 per particle, none for every 17th particle), a random
     /// model without slots (`Mechanics<D, 0>`) and a random state; n not a multiple of the

@@ -154,7 +154,7 @@ fn dilatation_one_cached<const D: usize, const K: usize>(
 
 /// Whether the AVX block kernels can run on this CPU.
 #[inline]
-fn use_avx() -> bool {
+pub(crate) fn use_avx() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx")
@@ -305,12 +305,12 @@ struct Inputs<'a, const D: usize, const K: usize> {
     dt: f64,
 }
 
-/// What pass 2 writes for one chunk of particles.
-struct ChunkOut<'b, const D: usize> {
-    xn: &'b mut [SVector<f64, D>],
-    vn: &'b mut [SVector<f64, D>],
-    fo: &'b mut [SVector<f64, D>],
-    dw: &'b mut [f64],
+/// What pass 2 writes for one chunk of particles (the slot and the CSR kernels).
+pub(crate) struct ChunkOut<'b, const D: usize> {
+    pub xn: &'b mut [SVector<f64, D>],
+    pub vn: &'b mut [SVector<f64, D>],
+    pub fo: &'b mut [SVector<f64, D>],
+    pub dw: &'b mut [f64],
 }
 
 /// The central-difference update of particle i given its internal force.
@@ -925,17 +925,7 @@ mod tests {
     use super::*;
     use crate::discretise::NONE;
 
-    /// Deterministic pseudo-random numbers in [0, 1).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
+    use crate::solver::test_rng::Lcg;
 
     /// A random model with some empty slots and a random state, n not a multiple of the
     /// chunk or block size.

@@ -12,6 +12,22 @@ pub mod modal;
 pub mod relaxation;
 pub mod time_step;
 
+/// Deterministic pseudo-random numbers for the kernels' unit tests.
+#[cfg(test)]
+pub(crate) mod test_rng {
+    /// A linear congruential generator, numbers in [0, 1).
+    pub struct Lcg(pub u64);
+    impl Lcg {
+        pub fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+}
+
 use kernel::State;
 use loading::{ramp_fraction, Prescribed};
 use mechanics::Mechanics;
