@@ -385,7 +385,7 @@ impl Dimension<2> for Dim<2> {
         let (p1, p2) = principal_values_2(t);
         [p1, p2]
     }
-    #[inline]
+    #[inline(always)]
     fn principal_strains(e: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64, f64) {
         let (e1, e2) = principal_values_2(e);
         let e3 = match plane {

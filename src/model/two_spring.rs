@@ -138,7 +138,7 @@ where
             p.eps_init = e1;
         }
         if p.initiated {
-            let band = law.crack_band * b.length;
+            let band = law.crack_band * b.length();
             p.wt = p.wt.max(damage::tensile_damage(law, band, e1, p.eps_init));
         }
         if FULL {
