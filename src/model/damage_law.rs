@@ -84,16 +84,8 @@ where
     pub a: f64,
     /// The undamaged dilatation term b_i·Σ S_e (for the force states of plastic flow).
     pub b_theta_elastic: f64,
-    /// Every particle's length scale L0,i (m; read through [`ParticleBonds::length`]), or
-    /// the one length of them all.
-    pub lengths: Lengths<'a>,
-}
-
-/// The particles' length scales: one for a lattice of one spacing, else one per particle.
-#[derive(Clone, Copy, Debug)]
-pub enum Lengths<'a> {
-    Uniform(f64),
-    PerParticle(&'a [f64]),
+    /// Every particle's length scale L0,i (m; read through [`ParticleBonds::length`]).
+    pub lengths: &'a [f64],
 }
 
 impl<const D: usize, const K: usize> ParticleBonds<'_, D, K>
@@ -104,10 +96,7 @@ where
     /// needs it).
     #[inline(always)]
     pub fn length(&self) -> f64 {
-        match self.lengths {
-            Lengths::Uniform(l) => l,
-            Lengths::PerParticle(l) => l[self.i],
-        }
+        self.lengths[self.i]
     }
 }
 

@@ -32,11 +32,10 @@
 //! (pass the scene's plane, or any value, in 3D).
 //!
 //! **Bit-identical 2D.** `Dim<2>` performs exactly the floating-point operations of the 2D
-//! functions it replaces (`strain::strain_fit`, `strain::strain_tensor`,
-//! `strain::principal_values`, `strain::principal_strains`, `plasticity::equivalent_stress`,
-//! `stress::von_mises`, `micro_modulus::elasticity_matrix`, `micro_modulus::stiffness_basis`,
-//! `micro_modulus::fit`), which are now thin wrappers over it; `tests` compares every one
-//! with a verbatim copy of the old code on random inputs with `==`.
+//! functions it replaced (the strain fit, strain tensor, principal values and strains,
+//! equivalent and von Mises stress of `strain`, `plasticity` and `stress`, removed since;
+//! `micro_modulus::elasticity_matrix`, `stiffness_basis` and `fit` remain as 2D wrappers);
+//! `tests` compares every one with a verbatim copy of the old code on random inputs with `==`.
 //!
 //! **3D principal values** are in closed form (trigonometric method on the deviator with
 //! the discriminant as a sum of squares, [`principal_values_3`]), accurate to round-off of
@@ -145,7 +144,7 @@ pub trait Dimension<const D: usize>: Copy + Default + Debug + Send + Sync + 'sta
     /// 3D: the three principal values, descending.
     fn principal_strains(e: &Tensor<D>, nu: f64, plane: Plane) -> (f64, f64, f64);
     /// (σ_max, σ_min): the largest and smallest principal stress including, in 2D, the
-    /// out-of-plane σ_zz (`plasticity::out_of_plane_stress`) — the pair the concrete
+    /// out-of-plane σ_zz ([`out_of_plane_stress`]) — the pair the concrete
     /// criteria take (§8, `damage::initiates`).
     fn principal_stress_extremes(s: &Tensor<D>, nu: f64, plane: Plane) -> (f64, f64);
     /// Von Mises equivalent stress √(3/2)·‖σ_dev‖ ((3.39), (3.40)); in 2D with σ_zz from the
@@ -971,12 +970,10 @@ mod tests {
             }
             let p = <D2 as Dimension<2>>::strain_fit(&dirs);
             assert_eq!(p, reference::strain_fit(&dirs));
-            assert_eq!(p, crate::model::strain::strain_fit(&dirs));
             let sc = scale(&mut r, 6.0);
             let s: [f64; 6] = std::array::from_fn(|_| range(&mut r, -sc, sc));
             let e = reference::strain_tensor(&p, &s);
             assert_eq!(<D2 as Dimension<2>>::strain_tensor(&p, &s), e);
-            assert_eq!(crate::model::strain::strain_tensor(&p, &s), e);
         }
     }
 
@@ -997,27 +994,23 @@ mod tests {
             let pl = plane(&mut r);
             let (p1, p2) = reference::principal_values(&t);
             assert_eq!(<D2 as Dimension<2>>::principal_values(&t), [p1, p2]);
-            assert_eq!(crate::model::strain::principal_values(&t), (p1, p2));
             let ps = reference::principal_strains(&t, nu, pl);
             assert_eq!(<D2 as Dimension<2>>::principal_strains(&t, nu, pl), ps);
-            assert_eq!(crate::model::strain::principal_strains(&t, nu, pl), ps);
             assert_eq!(
                 <D2 as Dimension<2>>::principal_stress_extremes(&t, nu, pl),
                 reference::extremes(&t, nu, pl)
             );
             let q = reference::equivalent_stress(&t, nu, pl);
             assert_eq!(<D2 as Dimension<2>>::equivalent_stress(&t, nu, pl), q);
-            assert_eq!(crate::model::plasticity::equivalent_stress(&t, nu, pl), q);
             let (sx, sy) = (t[(0, 0)], t[(1, 1)]);
             assert_eq!(
-                crate::model::plasticity::out_of_plane_stress(sx, sy, nu, pl),
+                out_of_plane_stress(sx, sy, nu, pl),
                 reference::out_of_plane_stress(sx, sy, nu, pl)
             );
             let vm = reference::von_mises(&t);
             assert_eq!(<D2 as Dimension<2>>::von_mises(&t), vm);
-            assert_eq!(crate::model::stress::von_mises(&t), vm);
             assert_eq!(
-                crate::model::stress::max_principal(&t),
+                <D2 as Dimension<2>>::max_principal(&t),
                 t.symmetric_eigenvalues().max()
             );
         }

@@ -4,21 +4,8 @@
 //! F_eff^(2/3), which is dimensionally inconsistent; the yield ratio is the von Mises form
 //! √(3/2)·‖σ_dev‖/F_eff, yielding at 1.
 
-use super::dimension::{Dim, Dimension};
-use crate::scene::Plane;
-use nalgebra::Matrix2;
-
-/// Out-of-plane stress σ_zz of a 2D particle: 0 in plane stress, ν·(σxx + σyy) (equally
-/// ν·(σ1 + σ2)) in plane strain.
-pub use super::dimension::out_of_plane_stress;
-
-/// Von Mises equivalent stress √(3/2)·‖σ_dev‖ ((3.39), (3.40)) of a 2D particle from its
-/// in-plane stress, with σ_zz from [`out_of_plane_stress`]. 2D wrapper of
-/// [`Dimension::equivalent_stress`].
-#[inline(always)]
-pub fn equivalent_stress(s: &Matrix2<f64>, nu: f64, plane: Plane) -> f64 {
-    <Dim<2> as Dimension<2>>::equivalent_stress(s, nu, plane)
-}
+//! The equivalent stress and the out-of-plane stress are `Dimension::equivalent_stress` and
+//! `dimension::out_of_plane_stress` (one source for 2D and 3D).
 
 /// Linear hardening (4.15): F_eff = f_y + (f_ult − f_y)·ε_eff/ε_ult.
 #[inline]
@@ -69,16 +56,21 @@ pub fn flow<const K: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::dimension::{out_of_plane_stress, Dim, Dimension};
+    use crate::scene::Plane;
+    use nalgebra::Matrix2;
 
     #[test]
     fn von_mises_of_uniaxial_and_shear() {
         let s = Matrix2::new(-30e6, 0.0, 0.0, 0.0);
-        assert!((equivalent_stress(&s, 0.2, Plane::Stress) - 30e6).abs() < 1e-6);
+        assert!((Dim::<2>::equivalent_stress(&s, 0.2, Plane::Stress) - 30e6).abs() < 1e-6);
         let t = Matrix2::new(0.0, 10e6, 10e6, 0.0);
-        assert!((equivalent_stress(&t, 0.2, Plane::Stress) - 3f64.sqrt() * 10e6).abs() < 1e-6);
+        assert!(
+            (Dim::<2>::equivalent_stress(&t, 0.2, Plane::Stress) - 3f64.sqrt() * 10e6).abs() < 1e-6
+        );
         // hydrostatic (plane strain, ν = 0.5 limit) is not yielding
         let h = Matrix2::new(-1e6, 0.0, 0.0, -1e6);
-        assert!(equivalent_stress(&h, 0.5, Plane::Strain) < 1e-6);
+        assert!(Dim::<2>::equivalent_stress(&h, 0.5, Plane::Strain) < 1e-6);
     }
 
     /// The 2D form equals √(3/2)·‖σ − tr(σ)/3·I‖ of the full 3×3 tensor.
@@ -100,7 +92,7 @@ mod tests {
             );
             let dev = full - nalgebra::Matrix3::identity() * (full.trace() / 3.0);
             let a = (1.5 * dev.norm_squared()).sqrt();
-            let b = equivalent_stress(&s, 0.2, plane);
+            let b = Dim::<2>::equivalent_stress(&s, 0.2, plane);
             assert!((a - b).abs() <= 1e-9 * a);
         }
     }

@@ -11,57 +11,18 @@
 //! any three independent bond directions. A particle with fewer independent directions gets
 //! the minimum-norm fit (pseudo-inverse).
 //!
-//! The functions here are the 2D instances of `model::dimension` (which also gives 3D).
-
-use crate::scene::Plane;
-use nalgebra::{Matrix2, Vector2};
-
-use super::dimension::{Dim, Dimension};
-
-/// Rows of the least-squares projector P_i (3×K): ε = [εxx, εyy, γxy] = P_i·S.
-/// (`<Dim<2> as Dimension<2>>::StrainFit<K>`.)
-pub type StrainFit<const K: usize> = [[f64; K]; 3];
-
-/// The projector of a particle whose slot k holds a bond of unit direction `dirs[k]`
-/// (`None` where the slot is empty). 2D wrapper of [`Dimension::strain_fit`].
-pub fn strain_fit<const K: usize>(dirs: &[Option<Vector2<f64>>; K]) -> StrainFit<K> {
-    <Dim<2> as Dimension<2>>::strain_fit(dirs)
-}
-
-/// The strain tensor (tensor shear) of stretches `s` through projector `p`. 2D wrapper of
-/// [`Dimension::strain_tensor`].
-#[inline(always)]
-pub fn strain_tensor<const K: usize>(p: &StrainFit<K>, s: &[f64; K]) -> Matrix2<f64> {
-    <Dim<2> as Dimension<2>>::strain_tensor(p, s)
-}
-
-/// Principal values p1 ≥ p2 of a symmetric 2×2 tensor in closed form,
-/// (a+c)/2 ± √(((a−c)/2)² + b²). Equal to nalgebra's symmetric eigen solver to round-off
-/// (`tests::closed_form_principal_values_match_nalgebra`). In the step kernel nalgebra's
-/// iterative solver took 13% of the samples (perf); with this and the 2D von Mises form the
-/// concrete kernel went from 6.47 to 6.76 M particle-steps/s (benchmarks/RESULTS.md).
-/// 2D wrapper of [`Dimension::principal_values`].
-#[inline(always)]
-pub fn principal_values(t: &Matrix2<f64>) -> (f64, f64) {
-    let [p1, p2] = <Dim<2> as Dimension<2>>::principal_values(t);
-    (p1, p2)
-}
-
-/// Principal strains ε1 ≥ ε2 in the plane and the out-of-plane ε3: 0 in plane strain,
-/// −ν/(1−ν)·(ε1+ε2) in plane stress (σ3 = 0, elastic). 2D wrapper of
-/// [`Dimension::principal_strains`].
-#[inline]
-pub fn principal_strains(e: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64, f64) {
-    <Dim<2> as Dimension<2>>::principal_strains(e, nu, plane)
-}
+//! The fit is `Dimension::strain_fit` / `Dimension::strain_tensor` of `model::dimension`,
+//! one source for 2D and 3D; the tests below check the decision in 2D.
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::model::dimension::{Dim, Dimension};
     use crate::model::micro_modulus::{
         elasticity_matrix, hexagonal, stiffness_basis, strain_projector,
     };
+    use crate::scene::Plane;
     use nalgebra::Vector3;
+    use nalgebra::{Matrix2, Vector2};
 
     fn hex_dirs(rot: f64, missing: &[usize]) -> [Option<Vector2<f64>>; 6] {
         let mut d = [None; 6];
@@ -89,7 +50,7 @@ mod tests {
         let eps = Vector3::new(1.3e-4, -0.4e-4, 0.7e-4);
         for missing in [&[][..], &[3], &[3, 4], &[2, 3, 4]] {
             let d = hex_dirs(0.3, missing);
-            let e = strain_tensor(&strain_fit(&d), &stretches(&d, &eps));
+            let e = Dim::<2>::strain_tensor(&Dim::<2>::strain_fit(&d), &stretches(&d, &eps));
             assert!((e[(0, 0)] - eps[0]).abs() < 1e-15);
             assert!((e[(1, 1)] - eps[1]).abs() < 1e-15);
             assert!((2.0 * e[(0, 1)] - eps[2]).abs() < 1e-15);
@@ -106,7 +67,7 @@ mod tests {
         let dinv = elasticity_matrix(e, nu, Plane::Stress)
             .try_inverse()
             .unwrap();
-        let p = strain_fit(&d);
+        let p = Dim::<2>::strain_fit(&d);
         let s = [1e-4, -3e-5, 2e-5, 7e-5, -1e-5, 4e-5];
         let theta: f64 = s.iter().sum();
         let mut sigma = Vector3::zeros();
@@ -115,7 +76,7 @@ mod tests {
             sigma += v * (l0 / (2.0 * vol)) * (m.a * s[k] + m.b * theta);
         }
         let via_d = dinv * sigma;
-        let fit = strain_tensor(&p, &s);
+        let fit = Dim::<2>::strain_tensor(&p, &s);
         let _ = stiffness_basis(&[], 1.0);
         assert!((fit[(0, 0)] - via_d[0]).abs() < 1e-12 * 1e-4);
         assert!((fit[(1, 1)] - via_d[1]).abs() < 1e-12 * 1e-4);
@@ -134,7 +95,7 @@ mod tests {
             let t = Matrix2::new(a, b, b, c);
             let ev = t.symmetric_eigenvalues();
             let (hi, lo) = (ev.max(), ev.min());
-            let (p1, p2) = principal_values(&t);
+            let [p1, p2] = Dim::<2>::principal_values(&t);
             let scale = t.norm().max(f64::MIN_POSITIVE);
             assert!((p1 - hi).abs() <= 1e-14 * scale && (p2 - lo).abs() <= 1e-14 * scale);
         }
@@ -143,7 +104,7 @@ mod tests {
     #[test]
     fn plane_stress_out_of_plane_strain() {
         let e = Matrix2::new(1e-4, 0.0, 0.0, -0.2e-4);
-        let (e1, e2, e3) = principal_strains(&e, 0.2, Plane::Stress);
+        let (e1, e2, e3) = Dim::<2>::principal_strains(&e, 0.2, Plane::Stress);
         assert!((e1 - 1e-4).abs() < 1e-19 && (e2 + 0.2e-4).abs() < 1e-19);
         assert!((e3 + 0.25 * 0.8e-4).abs() < 1e-18);
     }

@@ -1,8 +1,7 @@
 //! Particle stress (MODEL.md §7, (3.18)): σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(n_ij ⊗ n_ij),
 //! in any dimension D (2 by default).
 
-use super::dimension::{Dim, Dimension};
-use nalgebra::{Matrix2, SMatrix, SVector};
+use nalgebra::{SMatrix, SVector};
 
 /// Accumulates the stress (3.18) of one particle bond by bond, in D dimensions.
 #[derive(Clone, Copy, Debug)]
@@ -25,16 +24,4 @@ impl<const D: usize> StressSum<D> {
     pub fn finish(self, volume: f64) -> SMatrix<f64, D, D> {
         self.0 / (2.0 * volume)
     }
-}
-
-/// Von Mises equivalent stress of a plane stress state (σ3 = 0). 2D wrapper of
-/// [`Dimension::von_mises`].
-pub fn von_mises(s: &Matrix2<f64>) -> f64 {
-    <Dim<2> as Dimension<2>>::von_mises(s)
-}
-
-/// Largest principal stress (nalgebra's symmetric eigen solver). 2D wrapper of
-/// [`Dimension::max_principal`].
-pub fn max_principal(s: &Matrix2<f64>) -> f64 {
-    <Dim<2> as Dimension<2>>::max_principal(s)
 }

@@ -1,7 +1,6 @@
 //! Scalar particle fields for maps and VTK, with their labels and units.
 
 use crate::model::dimension::{Dim, Dimension};
-use crate::model::stress::{max_principal, von_mises};
 use crate::run::Outcome;
 use crate::scene::Field;
 
@@ -33,9 +32,11 @@ pub fn values(o: &Outcome, field: Field) -> Vec<f64> {
                 Field::StressXx => s[0] * 1e-6,
                 Field::StressYy => s[1] * 1e-6,
                 Field::StressXy => s[5] * 1e-6,
-                Field::StressVonMises => equivalent(o, i, von_mises, Dim::<3>::von_mises) * 1e-6,
+                Field::StressVonMises => {
+                    equivalent(o, i, Dim::<2>::von_mises, Dim::<3>::von_mises) * 1e-6
+                }
                 Field::MaxPrincipalStress => {
-                    equivalent(o, i, max_principal, Dim::<3>::max_principal) * 1e-6
+                    equivalent(o, i, Dim::<2>::max_principal, Dim::<3>::max_principal) * 1e-6
                 }
             }
         })

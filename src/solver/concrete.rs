@@ -36,7 +36,7 @@ use super::mechanics::Mechanics;
 use super::KernelSet;
 use crate::discretise::{Particles, NONE};
 pub use crate::model::damage_law::ParticleDamage;
-use crate::model::damage_law::{DamageLaw, Kernel, Lengths, ParticleBonds};
+use crate::model::damage_law::{DamageLaw, Kernel, ParticleBonds};
 use crate::model::dimension::{Dim, Dimension};
 use crate::model::force_state::{
     bond_energy, damaged_axial, damaged_bond_force, damaged_force_state, dilatation_term,
@@ -60,9 +60,6 @@ where
     pub reverse: Vec<[u8; K]>,
     /// Each particle's length scale L0,i (m; the body's `length`).
     pub length: Vec<f64>,
-    /// The length scale of every particle where they are all the same (lattices): the
-    /// kernel then reads no per-particle length.
-    uniform_length: Option<f64>,
     /// Committed law state (read by both passes of a step).
     pub committed: Vec<L::State>,
     trial: Vec<L::State>,
@@ -100,10 +97,6 @@ where
             fit,
             reverse: p.reverse.clone(),
             length: p.length.clone(),
-            uniform_length: match p.length.first() {
-                Some(&l) if p.length.iter().all(|&x| x == l) => Some(l),
-                _ => None,
-            },
             committed: vec![L::State::default(); n],
             trial: vec![L::State::default(); n],
             sps: vec![[0.0; K]; n],
@@ -294,10 +287,7 @@ where
         undamaged: same,
         a: m.a[i],
         b_theta_elastic: dilatation_term(m.b[i], theta_e),
-        lengths: match c.uniform_length {
-            Some(l) => Lengths::Uniform(l),
-            None => Lengths::PerParticle(&c.length),
-        },
+        lengths: &c.length,
     };
     c.law.update::<FULL>(&bonds, &mut state, sps_trial);
     *trial = state;

@@ -34,7 +34,7 @@
 //! `LAG = true` is reading (A) of MODEL.md §4: the force from the previous step's positions
 //! drives this step.
 
-use super::kernel::{central_difference, chunk_len, use_avx, ChunkOut, State};
+use super::kernel::{central_difference, chunk_len, update_in_chunks, use_avx, ChunkOut, State};
 use super::mechanics::Mechanics;
 use crate::discretise::csr::Csr;
 use crate::model::force_state::{bond_force, dilatation_term};
@@ -326,52 +326,23 @@ fn pass_update_impl<
     st: &mut State<D>,
     dt: f64,
 ) {
-    let State {
-        x,
-        v,
-        x_next,
-        v_next,
-        force,
-        force_prev,
-        b_theta,
-        damping_work,
-        bond_cache,
-    } = st;
-    let n = x.len();
+    let n = st.x.len();
     check_sizes(csr, m, n);
-    assert!([
-        v.len(),
-        x_next.len(),
-        v_next.len(),
-        force.len(),
-        force_prev.len(),
-        b_theta.len(),
-        damping_work.len()
-    ]
-    .iter()
-    .all(|&l| l == n));
-    assert!(!CACHE || bond_cache.len() == bond_cache_len(csr));
-    let inp = Inputs {
-        csr,
-        m,
-        x: &x[..],
-        v: &v[..],
-        b_theta: &b_theta[..],
-        force_prev: &force_prev[..],
-        cache: &bond_cache[..],
-        dt,
-    };
+    assert!(!CACHE || st.bond_cache.len() == bond_cache_len(csr));
     let avx = use_avx();
-    let chunk = chunk_len(n);
-    x_next
-        .par_chunks_mut(chunk)
-        .zip(v_next.par_chunks_mut(chunk))
-        .zip(force.par_chunks_mut(chunk))
-        .zip(damping_work.par_chunks_mut(chunk))
-        .enumerate()
-        .for_each(|(c, (((xn, vn), fo), dw))| {
-            update_chunk::<D, K, LAG, DAMP, CACHE>(inp, c * chunk, ChunkOut { xn, vn, fo, dw }, avx)
-        });
+    update_in_chunks(st, n, |base, r, out| {
+        let inp = Inputs {
+            csr,
+            m,
+            x: r.x,
+            v: r.v,
+            b_theta: r.b_theta,
+            force_prev: r.force_prev,
+            cache: r.cache,
+            dt,
+        };
+        update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out, avx)
+    });
 }
 
 /// Pass 2 without the bond cache: forces and the central-difference update of every

@@ -453,6 +453,40 @@ fn pass_update_impl<
     st: &mut State<D>,
     dt: f64,
 ) {
+    let n = m.len();
+    let avx = use_avx();
+    update_in_chunks(st, n, |base, r, out| {
+        let inp = Inputs {
+            m,
+            x: r.x,
+            v: r.v,
+            b_theta: r.b_theta,
+            force_prev: r.force_prev,
+            cache: r.cache,
+            dt,
+        };
+        update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out, avx)
+    });
+}
+
+/// What pass 2 reads of the state at step n (all particles).
+pub(crate) struct StateReads<'a, const D: usize> {
+    pub x: &'a [SVector<f64, D>],
+    pub v: &'a [SVector<f64, D>],
+    pub b_theta: &'a [f64],
+    pub force_prev: &'a [SVector<f64, D>],
+    pub cache: &'a [f64],
+}
+
+/// Pass 2's parallel frame, shared by the slot and the CSR kernels: checks that every
+/// per-particle array of the state holds `n` entries, then hands each chunk of
+/// [`chunk_len`]`(n)` particles (starting at `base`) its slice of x_next, v_next, force and
+/// damper work, with the state it reads, to `update(base, reads, out)`.
+pub(crate) fn update_in_chunks<const D: usize>(
+    st: &mut State<D>,
+    n: usize,
+    update: impl Fn(usize, StateReads<'_, D>, ChunkOut<'_, D>) + Sync,
+) {
     let State {
         x,
         v,
@@ -464,7 +498,6 @@ fn pass_update_impl<
         damping_work,
         bond_cache,
     } = st;
-    let n = m.len();
     assert!([
         x.len(),
         v.len(),
@@ -479,7 +512,6 @@ fn pass_update_impl<
     .all(|&l| l == n));
     let (x, v, b_theta, force_prev) = (&x[..], &v[..], &b_theta[..], &force_prev[..]);
     let cache = &bond_cache[..];
-    let avx = use_avx();
     let chunk = chunk_len(n);
     x_next
         .par_chunks_mut(chunk)
@@ -488,16 +520,14 @@ fn pass_update_impl<
         .zip(damping_work.par_chunks_mut(chunk))
         .enumerate()
         .for_each(|(c, (((xn, vn), fo), dw))| {
-            let inp = Inputs {
-                m,
+            let reads = StateReads {
                 x,
                 v,
                 b_theta,
                 force_prev,
                 cache,
-                dt,
             };
-            update_chunk::<D, K, LAG, DAMP, CACHE>(inp, c * chunk, ChunkOut { xn, vn, fo, dw }, avx)
+            update(c * chunk, reads, ChunkOut { xn, vn, fo, dw })
         });
 }
 
