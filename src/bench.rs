@@ -5,6 +5,7 @@
 
 use crate::discretise::csr::Csr;
 use crate::discretise::hex::HexLattice;
+use crate::discretise::random::{self, RandomParticles};
 use crate::geometry::Shape2;
 use crate::model::micro_modulus;
 use crate::scene::Plane;
@@ -28,6 +29,20 @@ pub struct BenchResult {
     pub layout: String,
     pub particle_steps_per_s: f64,
     pub seconds: f64,
+    /// "hexagonal" or "random".
+    pub lattice: String,
+    /// Random particles: the seconds their set-up took.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub setup: Option<Setup>,
+}
+
+/// Set-up of a random body (seconds): placement, Voronoi cells, bonds, least-squares moduli.
+#[derive(Clone, Debug, Serialize)]
+pub struct Setup {
+    pub placing_s: f64,
+    pub voronoi_s: f64,
+    pub bonding_s: f64,
+    pub moduli_s: f64,
 }
 
 /// Bond layout of a benchmark.
@@ -80,6 +95,7 @@ pub fn bench(
     threads: usize,
     kernel: KernelSet,
     layout: Layout,
+    lattice: &str,
 ) -> anyhow::Result<BenchResult> {
     anyhow::ensure!(
         layout == Layout::Slots || kernel == KernelSet::Elastic,
@@ -87,7 +103,6 @@ pub fn bench(
         layout.name(),
         kernel.name()
     );
-    let concrete = kernel != KernelSet::Elastic;
     let l0 = 1e-3;
     let side = (particles as f64 * 0.5 * 3f64.sqrt()).sqrt() * l0;
     let shape = Shape2::Rectangle {
@@ -101,11 +116,73 @@ pub fn bench(
         offset: Vector2::zeros(),
         thickness: 0.1,
     };
-    let mut p = lat.fill(&shape);
+    match lattice {
+        "hexagonal" => {
+            let mut p = lat.fill(&shape);
+            let n = p.len();
+            let mm = micro_modulus::hexagonal(30e9, 0.2, l0, 0.1, Plane::Stress);
+            p.a = vec![mm.a; n];
+            p.b = vec![mm.b; n];
+            time_steps(p, steps, threads, kernel, layout, None)
+        }
+        "random" => {
+            anyhow::ensure!(
+                layout == Layout::Slots,
+                "--layout {}: random particles run on \"slots\"",
+                layout.name()
+            );
+            let recipe = RandomParticles {
+                spacing: l0,
+                min_distance: random::DEFAULT_MIN_DISTANCE,
+                seed: 1,
+                thickness: 0.1,
+            };
+            let (mut p, _, g) = random::fill::<{ random::SLOTS_2D }>(&shape, &recipe)
+                .map_err(|e| anyhow::anyhow!("random particles: {e}"))?;
+            let t = Instant::now();
+            let d = micro_modulus::elasticity_matrix(30e9, 0.2, Plane::Stress);
+            let n = p.len();
+            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+            for i in 0..n {
+                let bonds: Vec<(Vector2<f64>, f64)> = (0..random::SLOTS_2D)
+                    .filter(|&k| p.neighbours[i][k] != crate::discretise::NONE)
+                    .map(|k| {
+                        let j = p.neighbours[i][k] as usize;
+                        ((p.x0[j] - p.x0[i]).normalize(), p.l0[i][k])
+                    })
+                    .collect();
+                let f =
+                    crate::model::dimension::fit_weighted_2d(&bonds, p.volume[i], p.length[i], &d)
+                        .ok_or_else(|| anyhow::anyhow!("particle {i} has no moduli fit"))?;
+                a[i] = f.moduli.a;
+                b[i] = f.moduli.b;
+            }
+            p.a = a;
+            p.b = b;
+            let setup = Setup {
+                placing_s: g.seconds_placing,
+                voronoi_s: g.seconds_voronoi,
+                bonding_s: g.seconds_bonding,
+                moduli_s: t.elapsed().as_secs_f64(),
+            };
+            time_steps(p, steps, threads, kernel, layout, Some(setup))
+        }
+        other => anyhow::bail!("--lattice {other}: \"hexagonal\" or \"random\""),
+    }
+}
+
+/// Time the steps of a filled body with its micro-moduli.
+fn time_steps<const K: usize>(
+    p: crate::discretise::Particles<2, K>,
+    steps: usize,
+    threads: usize,
+    kernel: KernelSet,
+    layout: Layout,
+    setup: Option<Setup>,
+) -> anyhow::Result<BenchResult> {
+    let concrete = kernel != KernelSet::Elastic;
+    let l0 = p.spacing;
     let n = p.len();
-    let mm = micro_modulus::hexagonal(30e9, 0.2, l0, 0.1, Plane::Stress);
-    p.a = vec![mm.a; n];
-    p.b = vec![mm.b; n];
     let mut mech = Mechanics::new(&p, &vec![2400.0; n]);
     let omega = crate::material::particle_frequency(30e9, 0.2, 2400.0, l0);
     for i in 0..n {
@@ -143,7 +220,7 @@ pub fn bench(
             plasticity: kernel == KernelSet::Full,
             crack_band: 2.8,
         };
-        crate::solver::concrete::Concrete::<2, 6>::new(
+        crate::solver::concrete::Concrete::<2, K>::new(
             crate::model::two_spring::TwoSpring::new(law, None),
             &p,
         )
@@ -160,8 +237,8 @@ pub fn bench(
     let mut one_step = |st: &mut State<2>| {
         match (model.as_mut(), &csr) {
             (Some(c), _) => c.step(&mech, st, dt, false, true),
-            (None, Some(csr)) => csr_kernel::step::<2, 6, false, true>(csr, &mech, st, dt),
-            (None, None) => kernel::step::<2, 6, false, true>(&mech, st, dt),
+            (None, Some(csr)) => csr_kernel::step::<2, K, false, true>(csr, &mech, st, dt),
+            (None, None) => kernel::step::<2, K, false, true>(&mech, st, dt),
         }
         std::mem::swap(&mut st.x, &mut st.x_next);
         std::mem::swap(&mut st.v, &mut st.v_next);
@@ -187,5 +264,12 @@ pub fn bench(
         layout: layout.name().into(),
         particle_steps_per_s: (n * steps) as f64 / seconds,
         seconds,
+        lattice: if setup.is_some() {
+            "random"
+        } else {
+            "hexagonal"
+        }
+        .into(),
+        setup,
     })
 }

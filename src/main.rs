@@ -62,6 +62,10 @@ enum Command {
         /// --model elastic only).
         #[arg(long, default_value = "slots")]
         layout: String,
+        /// Particles: "hexagonal" (the lattice) or "random" (SPPM; slots only; the set-up
+        /// times of placement, Voronoi cells, bonds and moduli are reported too).
+        #[arg(long, default_value = "hexagonal")]
+        lattice: String,
     },
     /// Many runs of one scene: lattice objectivity, convergence with the spacing, Monte Carlo
     /// size effect (and the merge of its shards).
@@ -173,62 +177,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     eprintln!("[{:7.1} s] {what}…", started.elapsed().as_secs_f64());
                 }
             };
-            let mut p = prepare_with(&sc, &stage)?;
-            stage("timing a few steps of the kernel");
-            // calibrate the run time with a few steps of the real kernel (with damage and
-            // plasticity where the scene has them)
-            let mut sim = sppm::run::build_simulation(&mut p);
-            let calib = 20.min(p.steps.max(1));
-            let t = std::time::Instant::now();
-            for _ in 0..calib {
-                sim.advance(None);
-            }
-            let per_step = t.elapsed().as_secs_f64() / calib as f64;
-            say!("scene            {}", sc.name());
-            say!("particles        {}", p.model.particles.len());
-            say!("bonds            {}", p.model.particles.bonds());
-            say!(
-                "groups           {}",
-                p.model
-                    .groups
-                    .iter()
-                    .map(|g| format!("{} ({})", g.name, g.members.len()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-            say!("fundamental T1   {:.6e} s", p.fundamental.period);
-            say!("stable dt        {:.6e} s", p.stable.dt_stable);
-            say!("time step dt     {:.6e} s", p.dt);
-            let threads = rayon::current_num_threads();
-            let solver = &sc.solver;
-            if solver.method == sppm::scene::SolverMethod::Relaxation {
-                // the iterations per increment are known only once it has converged
-                let most = solver.increments * solver.max_iterations;
-                say!(
-                    "solver           relaxation: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
-                    solver.increments, solver.max_iterations, solver.tolerance
-                );
-                say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-                say!(
-                    "run time (est.)  at most {:.1} s on {threads} threads ({most} iterations); elastic increments converge in 1–10",
-                    per_step * most as f64
-                );
+            if sppm::run::prepare::slots_of(&sc) == sppm::discretise::random::SLOTS_2D {
+                check::<{ sppm::discretise::random::SLOTS_2D }>(&sc, mem, &stage)?;
             } else {
-                say!("t_end            {:.6e} s", p.t_end);
-                say!("steps            {}", p.steps);
-                say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-                say!(
-                    "run time (est.)  {:.1} s on {threads} threads",
-                    per_step * p.steps as f64
-                );
-            }
-            say!(
-                "surface corr.    {} of {} boundary particles",
-                p.model.surface.corrected,
-                p.model.surface.boundary_particles
-            );
-            for d in &sc.derived {
-                say!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);
+                check::<6>(&sc, mem, &stage)?;
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -239,6 +191,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             threads,
             model,
             layout,
+            lattice,
         } => {
             anyhow::ensure!(
                 dim == 2,
@@ -274,11 +227,103 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 threads <= 4096,
                 "--threads {threads}: at most 4096 worker threads"
             );
-            let r = sppm::bench::bench(particles, steps.max(1), threads, kernel, layout)
+            let r = sppm::bench::bench(particles, steps.max(1), threads, kernel, layout, &lattice)
                 .context("benchmark failed")?;
             say!("{}", serde_json::to_string(&r)?);
             Ok(ExitCode::SUCCESS)
         }
         Command::Study { study } => sppm::study::cli::dispatch(study),
     }
+}
+
+/// `sppm check` of a scene whose body runs in K bond slots.
+fn check<const K: usize>(sc: &Scene, mem: f64, stage: &dyn Fn(&str)) -> anyhow::Result<()> {
+    let mut p = prepare_with::<K>(sc, stage)?;
+    stage("timing a few steps of the kernel");
+    // calibrate the run time with a few steps of the real kernel (with damage and
+    // plasticity where the scene has them)
+    let mut sim = sppm::run::build_simulation(&mut p);
+    let calib = 20.min(p.steps.max(1));
+    let t = std::time::Instant::now();
+    for _ in 0..calib {
+        sim.advance(None);
+    }
+    let per_step = t.elapsed().as_secs_f64() / calib as f64;
+    say!("scene            {}", sc.name());
+    say!("particles        {}", p.model.particles.len());
+    say!("bonds            {}", p.model.particles.bonds());
+    say!(
+        "groups           {}",
+        p.model
+            .groups
+            .iter()
+            .map(|g| format!("{} ({})", g.name, g.members.len()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    say!("fundamental T1   {:.6e} s", p.fundamental.period);
+    say!("stable dt        {:.6e} s", p.stable.dt_stable);
+    say!("time step dt     {:.6e} s", p.dt);
+    let threads = rayon::current_num_threads();
+    let solver = &sc.solver;
+    if solver.method == sppm::scene::SolverMethod::Relaxation {
+        // the iterations per increment are known only once it has converged
+        let most = solver.increments * solver.max_iterations;
+        say!(
+            "solver           relaxation: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
+            solver.increments, solver.max_iterations, solver.tolerance
+        );
+        say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+        say!(
+            "run time (est.)  at most {:.1} s on {threads} threads ({most} iterations); elastic increments converge in 1–10",
+            per_step * most as f64
+        );
+    } else {
+        say!("t_end            {:.6e} s", p.t_end);
+        say!("steps            {}", p.steps);
+        say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+        say!(
+            "run time (est.)  {:.1} s on {threads} threads",
+            per_step * p.steps as f64
+        );
+    }
+    say!(
+        "surface corr.    {} of {} boundary particles",
+        p.model.surface.corrected,
+        p.model.surface.boundary_particles
+    );
+    for d in &sc.derived {
+        say!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);
+    }
+    if let Some(r) = &p.model.random {
+        let g = &r.generation;
+        say!(
+            "random particles {} ({} on the outline; the density of a hexagonal lattice: {})",
+            g.particles,
+            g.outline_particles,
+            g.target
+        );
+        say!(
+            "nearest distance min {:.3} / mean {:.3} / max {:.3} × spacing",
+            g.nearest_min,
+            g.nearest_mean,
+            g.nearest_max
+        );
+        say!("bonds a particle {:?} (histogram from 0)", g.bond_histogram);
+        say!(
+            "generation       {:.3} s placing, {:.3} s Voronoi cells, {:.3} s bonds",
+            g.seconds_placing,
+            g.seconds_voronoi,
+            g.seconds_bonding
+        );
+        let m = &r.moduli;
+        say!(
+            "moduli residual  mean {:.4} / p99 {:.4} / max {:.4}; {} particle(s) without a fit",
+            m.residual_mean,
+            m.residual_p99,
+            m.residual_max,
+            m.unfitted
+        );
+    }
+    Ok(())
 }

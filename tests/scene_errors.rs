@@ -365,3 +365,54 @@ fn scenes_that_fail_at_discretisation_are_refused_before_running() {
         &["discretisation.spacing", "more than this machine has"],
     );
 }
+
+/// Random particles (SPPM): the minimum distance, the keys a random set does not have, a
+/// seed that is not an integer, and a body too small for three particles.
+#[test]
+fn random_particle_keys() {
+    for bad in ["0.8", "0.4", "1", "0", "-0.5"] {
+        let msg = error_of(&[
+            "discretisation.lattice=\"random\"",
+            &format!("discretisation.min_distance={bad}"),
+        ]);
+        says(&msg, &["discretisation.min_distance", bad, "[0.5, 0.75]"]);
+    }
+    let msg = error_of(&["discretisation.min_distance=0.7"]);
+    says(&msg, &["discretisation.min_distance", "hexagonal"]);
+    let msg = error_of(&[
+        "discretisation.lattice=\"random\"",
+        "discretisation.rotation_deg=15",
+    ]);
+    says(&msg, &["rotation_deg", "15", "random"]);
+    let msg = error_of(&[
+        "discretisation.lattice=\"random\"",
+        "discretisation.surface_correction=true",
+    ]);
+    says(&msg, &["discretisation.surface_correction", "random"]);
+    let msg = error_of(&["discretisation.lattice=\"random\"", "seed=1.5"]);
+    says(&msg, &["seed", "1.5"]);
+    let msg = error_of(&["discretisation.lattice=\"voronoi\""]);
+    says(&msg, &["discretisation.lattice", "voronoi", "random"]);
+}
+
+#[test]
+fn a_body_too_small_for_random_particles_is_refused() {
+    // a 12 × 12 mm plate at a 7 mm spacing would hold about 3 random particles
+    let s = Scene::from_toml_str(
+        BASE,
+        &[
+            "discretisation.lattice=\"random\"".into(),
+            "body.width=0.012".into(),
+            "body.height=0.012".into(),
+            "discretisation.spacing=0.007".into(),
+        ],
+    );
+    let msg = match s {
+        Err(e) => e.to_string(),
+        Ok(s) => match sppm::run::prepare::prepare_random(&s) {
+            Err(e) => e.to_string(),
+            Ok(p) => panic!("{} particles accepted", p.model.particles.len()),
+        },
+    };
+    says(&msg, &["discretisation.spacing"]);
+}

@@ -43,6 +43,11 @@ impl Csr {
     /// [`Particles::check_topology`]) or where the bonds do not fit 32-bit positions.
     pub fn from_slots<const D: usize, const K: usize>(p: &Particles<D, K>) -> Result<Self, String> {
         let n = p.len();
+        if p.weighted_dilatation {
+            return Err(
+                "the body weighs its dilatations by bond length (random particles); the CSR kernel sums them unweighted, so run it on slots".into(),
+            );
+        }
         if p.neighbours.len() != n || p.reverse.len() != n || p.l0.len() != n {
             return Err(format!(
                 "slot arrays of {} particles hold {} neighbour, {} reverse and {} length rows",

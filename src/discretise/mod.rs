@@ -12,6 +12,8 @@
 pub mod csr;
 pub mod groups;
 pub mod hex;
+pub mod random;
+pub mod voronoi;
 
 use nalgebra::SVector;
 
@@ -47,6 +49,10 @@ pub struct Particles<const D: usize, const K: usize> {
     /// Nominal spacing of the discretisation (m): the row pitch by which groups select edge
     /// rows. Per-particle quantities use [`Self::length`].
     pub spacing: f64,
+    /// Whether the dilatation of particle i weighs each bond by L0,im/ℓ_i (ℓ_i =
+    /// [`Self::length`]): θ_i = Σ_m (L0,im/ℓ_i)·S_im. Random particles need it (MODEL.md §13,
+    /// "dilatation of unequal bonds"); on a lattice every weight would be 1, so it is off.
+    pub weighted_dilatation: bool,
 }
 
 impl<const D: usize, const K: usize> Particles<D, K> {
@@ -74,6 +80,7 @@ impl<const D: usize, const K: usize> Particles<D, K> {
             b: vec![0.0; n],
             c: vec![0.0; n],
             spacing,
+            weighted_dilatation: false,
         };
         p.measure_bonds();
         p

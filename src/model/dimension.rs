@@ -253,6 +253,17 @@ pub fn stiffness_basis<const D: usize, const V: usize, L: Layout<D, V>>(
     bonds: &[(Vector<D>, f64)],
     volume: f64,
 ) -> (SMatrix<f64, V, V>, SMatrix<f64, V, V>) {
+    stiffness_basis_weighted::<D, V, L>(bonds, volume, None)
+}
+
+/// [`stiffness_basis`] of a particle whose dilatation weighs bond m by L0,m/ℓ
+/// (`ell = Some(ℓ)`; random particles, MODEL.md §13): B = (M·1)(wᵀN), symmetric. `None`:
+/// the unweighted θ = Σ S of the lattices.
+pub fn stiffness_basis_weighted<const D: usize, const V: usize, L: Layout<D, V>>(
+    bonds: &[(Vector<D>, f64)],
+    volume: f64,
+    ell: Option<f64>,
+) -> (SMatrix<f64, V, V>, SMatrix<f64, V, V>) {
     let mut a = SMatrix::<f64, V, V>::zeros();
     let mut mv = SVector::<f64, V>::zeros();
     let mut nv = SVector::<f64, V>::zeros();
@@ -261,9 +272,28 @@ pub fn stiffness_basis<const D: usize, const V: usize, L: Layout<D, V>>(
         let w = l0 / (2.0 * volume);
         a += v * v.transpose() * w;
         mv += v * w;
-        nv += v;
+        match ell {
+            Some(ell) => nv += v * (l0 / ell),
+            None => nv += v,
+        }
     }
     (a, mv * nv.transpose())
+}
+
+/// The least-squares (a, b) of a 2D particle with weighted dilatation (random particles):
+/// D ≈ a·A + b·B with B from [`stiffness_basis_weighted`].
+pub fn fit_weighted_2d(
+    bonds: &[(Vector<2>, f64)],
+    volume: f64,
+    ell: f64,
+    d: &Matrix3<f64>,
+) -> Option<Fit> {
+    let (a_m, b_m) = stiffness_basis_weighted::<2, 3, Voigt3>(bonds, volume, Some(ell));
+    let ([a, b], residual) = least_squares(&[a_m, b_m], d, |_| true)?;
+    Some(Fit {
+        moduli: MicroModuli { a, b },
+        residual,
+    })
 }
 
 /// Least-squares coefficients x with d ≈ Σ_p x_p·basis[p] (Frobenius norm) and the relative

@@ -6,6 +6,7 @@ pub mod dimension;
 pub mod force_state;
 pub mod micro_modulus;
 pub mod plasticity;
+pub mod sppm_calibration;
 pub mod strain;
 pub mod stress;
 pub mod stretch;

@@ -143,6 +143,8 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
 /// and the disc radius that makes neighbouring particles touch.
 struct Frame {
     pos: Vec<(f64, f64)>,
+    /// Random particles: each particle's Voronoi cell (mm), moved with the particle.
+    cells: Option<Vec<Vec<(f64, f64)>>>,
     x: std::ops::Range<f64>,
     y: std::ops::Range<f64>,
     plot_w: f64,
@@ -172,13 +174,54 @@ impl Frame {
         let l0 = o.summary.spacing_m * 1e3;
         let (x0, x1, y0, y1) = (x0 - l0, x1 + l0, y0 - l0, y1 + l0);
         let plot_w = 700.0;
+        let cells = o.cells.as_ref().map(|cells| {
+            cells
+                .iter()
+                .zip(&o.displacement)
+                .map(|(c, u)| {
+                    c.iter()
+                        .map(|v| ((v[0] + scale * u[0]) * 1e3, (v[1] + scale * u[1]) * 1e3))
+                        .collect()
+                })
+                .collect()
+        });
         Frame {
             pos,
+            cells,
             x: x0..x1,
             y: y0..y1,
             plot_w,
             plot_h: (plot_w * (y1 - y0) / (x1 - x0)).clamp(150.0, 1400.0),
             radius: ((0.5 * l0 * plot_w / (x1 - x0)).round() as i32).max(1),
+        }
+    }
+
+    /// Every particle filled with its colour: its Voronoi cell for random particles, else a
+    /// disc of [`Self::radius`].
+    fn fill<'a, 'b>(
+        &self,
+        chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+        colours: impl Iterator<Item = RGBColor>,
+    ) -> anyhow::Result<()> {
+        match &self.cells {
+            Some(cells) => chart
+                .draw_series(
+                    cells
+                        .iter()
+                        .zip(colours)
+                        .map(|(c, col)| Polygon::new(c.clone(), col.filled())),
+                )
+                .map(|_| ())
+                .map_err(err),
+            None => chart
+                .draw_series(
+                    self.pos
+                        .iter()
+                        .zip(colours)
+                        .map(|(&p, col)| Circle::new(p, self.radius, col.filled())),
+                )
+                .map(|_| ())
+                .map_err(err),
         }
     }
 
@@ -216,7 +259,8 @@ impl Frame {
     }
 }
 
-/// particle_map.svg: every particle as a disc coloured by `field`, at x0 + scale·u.
+/// particle_map.svg: every particle as a disc (random particles: as its Voronoi cell)
+/// coloured by `field`, at x0 + scale·u.
 pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyhow::Result<()> {
     value_map(
         o,
@@ -270,15 +314,10 @@ fn value_map(
     let (main, bar) = root.split_horizontally(width - 140);
     let mut chart = frame.chart(&main, o, label, scale, "x (mm)".into(), 40)?;
     let radius = frame.radius;
-    chart
-        .draw_series(
-            frame
-                .pos
-                .iter()
-                .zip(values)
-                .map(|(&p, &v)| Circle::new(p, radius, viridis((v - vmin) / span).filled())),
-        )
-        .map_err(err)?;
+    frame.fill(
+        &mut chart,
+        values.iter().map(|&v| viridis((v - vmin) / span)),
+    )?;
     if let (true, Some(damage)) = (cracks, &o.damage) {
         chart
             .draw_series(
@@ -355,13 +394,7 @@ pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
         60,
     )?;
     let (pos, radius) = (&frame.pos, frame.radius);
-    chart
-        .draw_series(
-            pos.iter()
-                .zip(damage)
-                .map(|(&p, d)| Circle::new(p, radius, damage_colour(d.wt).filled())),
-        )
-        .map_err(err)?;
+    frame.fill(&mut chart, damage.iter().map(|d| damage_colour(d.wt)))?;
     chart
         .draw_series(
             pos.iter()

@@ -72,6 +72,15 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
             }
         }
     }
+    if let Some(r) = &o.moduli_residual {
+        writeln!(
+            w,
+            "\nSCALARS micro_modulus_residual float 1\nLOOKUP_TABLE default"
+        )?;
+        for v in r {
+            be(&mut w, *v)?;
+        }
+    }
     // random fields (MODEL.md §12), in the units of their names
     for f in &o.fields {
         let (name, unit) = f.label();

@@ -1,9 +1,10 @@
 //! Stage 2 of a run: the explicit or relaxation solver on a prepared model, with probes, to
 //! a dimension-erased [`Outcome`].
 
-use super::prepare::{prepare, Prepared};
+use super::prepare::{prepare_with, slots_of, Prepared};
 use super::summary::{point3, summarise, voigt6, Finished, Outcome, SolverReport};
 use super::{RunError, RunOptions};
+use crate::discretise::random;
 use crate::material::properties;
 use crate::model::force_state::{dilatation_term, force_state};
 use crate::model::stress::StressSum;
@@ -18,16 +19,20 @@ use std::time::Instant;
 
 /// Particle stresses (3.18) at positions x: σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(e_ij ⊗ e_ij)
 /// with F_s,ij = a_i·S_ij + b_i·Σ_m S_im and e_ij the current bond direction.
-pub fn particle_stress(
-    mech: &Mechanics<2, 6>,
+pub fn particle_stress<const K: usize>(
+    mech: &Mechanics<2, K>,
     volume: &[f64],
     x: &[Vector2<f64>],
 ) -> Vec<Matrix2<f64>> {
     (0..x.len())
         .map(|i| {
             let mut theta = 0.0;
-            for (_, j, il) in mech.bonds(i) {
-                theta += total_stretch((x[j] - x[i]).norm(), il);
+            for (k, j, il) in mech.bonds(i) {
+                let s = total_stretch((x[j] - x[i]).norm(), il);
+                theta += match &mech.dilatation_weight {
+                    Some(w) => w[i][k] * s,
+                    None => s,
+                };
             }
             let mut acc = StressSum::default();
             for (_, j, il) in mech.bonds(i) {
@@ -56,12 +61,18 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
         .num_threads(threads)
         .build()
         .map_err(|e| RunError::Setup(format!("cannot start {threads} threads: {e}")))?;
-    pool.install(|| run_prepared(prepare(scene)?, opts, threads))
+    pool.install(|| {
+        if slots_of(scene) == random::SLOTS_2D {
+            run_prepared::<{ random::SLOTS_2D }>(prepare_with(scene, &|_| {})?, opts, threads)
+        } else {
+            run_prepared::<6>(prepare_with(scene, &|_| {})?, opts, threads)
+        }
+    })
 }
 
 /// The simulation of a prepared scene, at rest, taking over the model's arrays (no copy);
 /// with `[concrete]`, the damage and plasticity kernel is on.
-pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
+pub fn build_simulation<const K: usize>(p: &mut Prepared<K>) -> Simulation<2, K> {
     let integration = Integration {
         dt: p.dt,
         lagged_forces: p.model.scene.solver.force_lag == crate::scene::ForceLag::Previous,
@@ -76,13 +87,17 @@ pub fn build_simulation(p: &mut Prepared) -> Simulation<2, 6> {
     );
     if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
         let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
-        let c: Concrete<2, 6> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
+        let c: Concrete<2, K> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
         sim.inelastic = Some(Box::new(c));
     }
     sim
 }
 
-fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Outcome, RunError> {
+fn run_prepared<const K: usize>(
+    mut p: Prepared<K>,
+    opts: &RunOptions,
+    threads: usize,
+) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let method = p.model.scene.solver.method;
     if method == SolverMethod::Relaxation {
@@ -166,6 +181,13 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
     );
     let outcome = Outcome {
         summary,
+        cells: p.model.random.as_ref().map(|r| {
+            r.cells
+                .iter()
+                .map(|c| c.iter().map(|v| [v.x, v.y]).collect())
+                .collect()
+        }),
+        moduli_residual: p.model.random.as_ref().map(|r| r.moduli.residual.clone()),
         records,
         dim: 2,
         x0: p.model.particles.x0.iter().map(point3).collect(),
@@ -181,9 +203,9 @@ fn run_prepared(mut p: Prepared, opts: &RunOptions, threads: usize) -> Result<Ou
 
 /// The explicit run to t_end with probe records (and the wall time at each), stopping at an
 /// instability, or after the peak with `loading.stop_after_peak` (then `true`).
-fn run_explicit(
-    sim: &mut Simulation<2, 6>,
-    p: &Prepared,
+fn run_explicit<const K: usize>(
+    sim: &mut Simulation<2, K>,
+    p: &Prepared<K>,
     probe: &Probe,
     opts: &RunOptions,
     start: Instant,

@@ -2,7 +2,8 @@
 //! micro-moduli, random fields), then T1, the dampers and the stable time step.
 
 use super::RunError;
-use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
+use crate::discretise::random::{self, Generation, RandomParticles};
+use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles, NONE};
 use crate::limits::available_memory;
 use crate::material;
 use crate::material::properties::{self, SampledField};
@@ -29,9 +30,33 @@ pub struct SurfaceCorrection {
     pub max_residual: f64,
 }
 
+/// What a random body (SPPM) adds to the model: its Voronoi cells, what generation
+/// measured, and how well each particle's fitted micro-moduli reproduce D.
+#[derive(Clone, Debug)]
+pub struct RandomBody {
+    /// Each particle's Voronoi cell clipped to the body (counter-clockwise polygon, m).
+    pub cells: Vec<Vec<Vector2<f64>>>,
+    pub generation: Generation,
+    pub moduli: ModuliFit,
+}
+
+/// The per-particle least-squares micro-moduli of a random body (MODEL.md §3, (3.20)).
+#[derive(Clone, Debug, Serialize)]
+pub struct ModuliFit {
+    /// ‖a_i·A_i + b_i·B_i − D‖/‖D‖ of each particle (NaN where no fit exists).
+    #[serde(skip)]
+    pub residual: Vec<f64>,
+    pub residual_mean: f64,
+    pub residual_p99: f64,
+    pub residual_max: f64,
+    /// Particles whose bonds cannot carry a fit (too few, or too nearly collinear, or a fit
+    /// with a ≤ 0): they keep the hexagonal lattice's constants at their own length.
+    pub unfitted: usize,
+}
+
 /// A discretised, assembled specimen ready to run: the model plus its dynamics.
-pub struct Prepared {
-    pub model: Model,
+pub struct Prepared<const K: usize = 6> {
+    pub model: Model<K>,
     pub fundamental: modal::Fundamental,
     pub stable: StableStep,
     pub dt: f64,
@@ -51,18 +76,31 @@ pub fn estimated_memory(scene: &Scene) -> f64 {
     estimated_particles(scene) * bytes_per_particle(2, 6) as f64
 }
 
-/// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step).
-pub struct Model {
+/// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step), in
+/// `K` bond slots (6: the hexagonal lattice; [`random::SLOTS_2D`]: random particles).
+pub struct Model<const K: usize = 6> {
     pub scene: Scene,
-    pub particles: Particles<2, 6>,
+    pub particles: Particles<2, K>,
     pub groups: Vec<groups::Group>,
     pub prescribed: Vec<Prescribed>,
     pub constrained: Vec<[bool; 2]>,
-    pub mech: Mechanics<2, 6>,
+    pub mech: Mechanics<2, K>,
     pub bulk: MicroModuli,
     pub surface: SurfaceCorrection,
     /// The scene's random fields sampled at the particles (MODEL.md §12).
     pub fields: Vec<SampledField>,
+    /// Random particles only: cells, generation, fitted moduli.
+    pub random: Option<RandomBody>,
+}
+
+/// Bond slots the scene's discretisation needs: 6 for the hexagonal lattice,
+/// [`random::SLOTS_2D`] for random particles.
+pub fn slots_of(scene: &Scene) -> usize {
+    if scene.discretisation.lattice == "random" {
+        random::SLOTS_2D
+    } else {
+        6
+    }
 }
 
 /// Discretise a scene and assemble its model: lattice, groups, supports, micro-moduli.
@@ -70,8 +108,109 @@ pub fn prepare_model(scene: &Scene) -> Result<Model, RunError> {
     prepare_model_with(scene, &|_| {})
 }
 
+/// [`prepare_model`] for a scene of random particles.
+pub fn prepare_model_random(scene: &Scene) -> Result<Model<{ random::SLOTS_2D }>, RunError> {
+    prepare_model_with(scene, &|_| {})
+}
+
+/// [`prepare_model_random`] with the moduli fitted to the scene's own (E, ν), without the
+/// elastic calibration of `model::sppm_calibration`: how that calibration is measured.
+pub fn prepare_model_random_uncalibrated(
+    scene: &Scene,
+) -> Result<Model<{ random::SLOTS_2D }>, RunError> {
+    assemble(scene, &|_| {}, false)
+}
+
+/// The body of a scene in K slots: the hexagonal lattice or random particles (with their
+/// cells and generation report).
+#[allow(clippy::type_complexity)]
+fn discretise<const K: usize>(
+    scene: &Scene,
+    shape: &crate::geometry::Shape2,
+) -> Result<
+    (
+        Particles<2, K>,
+        Option<(Vec<Vec<Vector2<f64>>>, Generation)>,
+    ),
+    RunError,
+> {
+    let d = &scene.discretisation;
+    if K != slots_of(scene) {
+        return Err(RunError::Setup(format!(
+            "discretisation.lattice = {:?} runs in {} bond slots, not {K} (use run::prepare_model{})",
+            d.lattice,
+            slots_of(scene),
+            if d.lattice == "random" { "_random" } else { "" }
+        )));
+    }
+    if d.lattice == "random" {
+        let recipe = RandomParticles {
+            spacing: d.spacing,
+            min_distance: d.min_distance.unwrap_or(random::DEFAULT_MIN_DISTANCE),
+            seed: scene.seed.unwrap_or(crate::scene::DEFAULT_SEED),
+            thickness: scene.material.thickness,
+        };
+        let (p, cells, generation) = random::fill::<K>(shape, &recipe).map_err(|e| {
+            RunError::Setup(format!(
+                "discretisation.spacing = {} (lattice = \"random\", min_distance = {}): {e}",
+                d.spacing, recipe.min_distance
+            ))
+        })?;
+        return Ok((p, Some((cells, generation))));
+    }
+    let lattice = HexLattice {
+        spacing: d.spacing,
+        rotation_deg: d.rotation_deg,
+        offset: Vector2::new(d.offset[0], d.offset[1]),
+        thickness: scene.material.thickness,
+    };
+    Ok((reslot(lattice.fill(shape)), None))
+}
+
+/// A body in A slots moved to B ≥ (its largest bond count) slots.
+fn reslot<const A: usize, const B: usize>(p: Particles<2, A>) -> Particles<2, B> {
+    let n = p.len();
+    let mut neighbours = vec![[NONE; B]; n];
+    let mut reverse = vec![[0u8; B]; n];
+    let mut l0 = vec![[0.0; B]; n];
+    for i in 0..n {
+        for k in 0..A.min(B) {
+            neighbours[i][k] = p.neighbours[i][k];
+            reverse[i][k] = p.reverse[i][k];
+            l0[i][k] = p.l0[i][k];
+        }
+    }
+    Particles {
+        x0: p.x0,
+        volume: p.volume,
+        neighbours,
+        reverse,
+        l0,
+        horizon: p.horizon,
+        length: p.length,
+        a: p.a,
+        b: p.b,
+        c: p.c,
+        spacing: p.spacing,
+        weighted_dilatation: p.weighted_dilatation,
+    }
+}
+
 /// [`prepare_model`], telling `stage` what it starts (for `sppm check` of large bodies).
-pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, RunError> {
+pub fn prepare_model_with<const K: usize>(
+    scene: &Scene,
+    stage: &dyn Fn(&str),
+) -> Result<Model<K>, RunError> {
+    assemble(scene, stage, true)
+}
+
+/// [`prepare_model_with`]; `calibrate`: random particles are fitted to the calibrated target
+/// (E*, ν*) of `model::sppm_calibration` rather than to the scene's (E, ν).
+fn assemble<const K: usize>(
+    scene: &Scene,
+    stage: &dyn Fn(&str),
+    calibrate: bool,
+) -> Result<Model<K>, RunError> {
     let d = &scene.discretisation;
     let m = &scene.material;
     let need = estimated_memory(scene);
@@ -94,17 +233,11 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
         )));
     }
     let shape = scene.shape();
-    let lattice = HexLattice {
-        spacing: d.spacing,
-        rotation_deg: d.rotation_deg,
-        offset: Vector2::new(d.offset[0], d.offset[1]),
-        thickness: m.thickness,
-    };
     stage(&format!(
         "filling the body with about {:.3e} particles",
         estimated_particles(scene)
     ));
-    let particles = lattice.fill(&shape);
+    let (particles, random_body) = discretise::<K>(scene, &shape)?;
     if particles.len() < 2 {
         return Err(RunError::Setup(format!(
             "discretisation.spacing = {}: the body holds {} bonded particles at this spacing, rotation and offset; at least 2 are needed (use a smaller spacing)",
@@ -196,25 +329,16 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
         kept_bulk: 0,
         max_residual: 0.0,
     };
+    let is_random = random_body.is_some();
     for i in 0..n {
-        if particles.bond_count(i) == 6 {
+        if is_random || particles.bond_count(i) == 6 {
             continue;
         }
         surface.boundary_particles += 1;
         if !d.surface_correction {
             continue;
         }
-        let bonds: Vec<(Vector2<f64>, f64)> = (0..6)
-            .filter(|&k| particles.neighbours[i][k] != crate::discretise::NONE)
-            .map(|k| {
-                let j = particles.neighbours[i][k] as usize;
-                (
-                    (particles.x0[j] - particles.x0[i]).normalize(),
-                    particles.l0[i][k],
-                )
-            })
-            .collect();
-        match micro_modulus::fit(&bonds, particles.volume[i], &dmat) {
+        match micro_modulus::fit(&bond_list(&particles, i), particles.volume[i], &dmat) {
             Some(f) => {
                 a[i] = f.moduli.a;
                 b[i] = f.moduli.b;
@@ -224,6 +348,65 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
             None => surface.kept_bulk += 1,
         }
     }
+    // Random particles: every particle's own least-squares constants (MODEL.md §3, (3.20)).
+    let target = match (&random_body, calibrate) {
+        (Some(_), true) => {
+            let md = d.min_distance.unwrap_or(random::DEFAULT_MIN_DISTANCE);
+            let (e, nu) =
+                crate::model::sppm_calibration::fit_target(m.youngs_modulus(), m.nu, m.plane, md)
+                    .map_err(|allowed| {
+                    RunError::Scene(crate::scene::SceneError::Invalid {
+                        key: "material.nu".into(),
+                        value: m.nu.to_string(),
+                        allowed,
+                    })
+                })?;
+            micro_modulus::elasticity_matrix(e, nu, m.plane)
+        }
+        _ => dmat,
+    };
+    let random = random_body.map(|(cells, generation)| {
+        stage("micro-moduli of every particle (least squares)");
+        let mut residual = vec![f64::NAN; n];
+        let mut unfitted = 0;
+        for i in 0..n {
+            let fit = crate::model::dimension::fit_weighted_2d(
+                &bond_list(&particles, i),
+                particles.volume[i],
+                particles.length[i],
+                &target,
+            );
+            match fit {
+                Some(f) => {
+                    a[i] = f.moduli.a;
+                    b[i] = f.moduli.b;
+                    residual[i] = f.residual;
+                }
+                None => unfitted += 1,
+            }
+        }
+        let mut fitted: Vec<f64> = residual.iter().copied().filter(|r| r.is_finite()).collect();
+        fitted.sort_by(f64::total_cmp);
+        let pick = |q: f64| {
+            if fitted.is_empty() {
+                f64::NAN
+            } else {
+                fitted[((q * (fitted.len() - 1) as f64).round() as usize).min(fitted.len() - 1)]
+            }
+        };
+        let moduli = ModuliFit {
+            residual_mean: fitted.iter().sum::<f64>() / fitted.len().max(1) as f64,
+            residual_p99: pick(0.99),
+            residual_max: pick(1.0),
+            residual,
+            unfitted,
+        };
+        RandomBody {
+            cells,
+            generation,
+            moduli,
+        }
+    });
     if !scene.random_field.is_empty() {
         stage("random fields");
     }
@@ -255,11 +438,23 @@ pub fn prepare_model_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Model, 
         bulk,
         surface,
         fields,
+        random,
     })
 }
 
+/// The bonds of particle i as (reference unit direction, reference length).
+fn bond_list<const K: usize>(p: &Particles<2, K>, i: usize) -> Vec<(Vector2<f64>, f64)> {
+    (0..K)
+        .filter(|&k| p.neighbours[i][k] != NONE)
+        .map(|k| {
+            let j = p.neighbours[i][k] as usize;
+            ((p.x0[j] - p.x0[i]).normalize(), p.l0[i][k])
+        })
+        .collect()
+}
+
 /// A failed modal analysis, with the scene keys T1 depends on.
-fn modal_failure(model: &Model, e: modal::ModalError) -> RunError {
+fn modal_failure<const K: usize>(model: &Model<K>, e: modal::ModalError) -> RunError {
     let text = e.to_string();
     if text.contains("every particle is constrained") {
         return RunError::Setup(format!("{text}: groups fix or load every component of every particle, so nothing is left to move; free some components (groups.*.fix, groups.*.load)"));
@@ -287,8 +482,16 @@ pub fn prepare(scene: &Scene) -> Result<Prepared, RunError> {
     prepare_with(scene, &|_| {})
 }
 
+/// [`prepare`] for a scene of random particles.
+pub fn prepare_random(scene: &Scene) -> Result<Prepared<{ random::SLOTS_2D }>, RunError> {
+    prepare_with(scene, &|_| {})
+}
+
 /// [`prepare`], telling `stage` what it starts (for `sppm check` of large bodies).
-pub fn prepare_with(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Prepared, RunError> {
+pub fn prepare_with<const K: usize>(
+    scene: &Scene,
+    stage: &dyn Fn(&str),
+) -> Result<Prepared<K>, RunError> {
     let mut model = prepare_model_with(scene, stage)?;
     stage("fundamental period T1 (Lanczos)");
     let m = &scene.material;

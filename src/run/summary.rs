@@ -85,6 +85,10 @@ pub struct Summary {
     /// The step kernel chosen for the scene's features: elastic, tension or full.
     pub kernel: crate::solver::KernelSet,
     pub surface_correction: SurfaceCorrection,
+    /// Random particles (SPPM): generation (count, distances, bond histogram, times), the
+    /// minimum distance, and the micro-moduli residual statistics; absent for lattices.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub random_particles: Option<RandomReport>,
     pub micro_modulus_a_bulk: f64,
     pub micro_modulus_b_bulk: f64,
     pub spacing_m: f64,
@@ -99,12 +103,27 @@ pub struct Summary {
     pub sppm_version: String,
 }
 
+/// What a random body reports in summary.json.
+#[derive(Clone, Debug, Serialize)]
+pub struct RandomReport {
+    /// Minimum distance between particles (fraction of the spacing).
+    pub min_distance: f64,
+    pub generation: crate::discretise::random::Generation,
+    pub micro_moduli: super::prepare::ModuliFit,
+}
+
 /// What a run produces, dimension-erased: points and displacements as 3-vectors (z = 0 in
 /// 2D), stresses as 6 Voigt components [σxx, σyy, σzz, σyz, σxz, σxy] (in 2D the
 /// out-of-plane components are 0, as the 2D reports always showed them), so that `output`
 /// and `study` serve every dimension from one copy.
 pub struct Outcome {
     pub summary: Summary,
+    /// Random particles: each particle's Voronoi cell clipped to the body (reference
+    /// polygon, m), for the maps; `None` for lattices.
+    pub cells: Option<Vec<Vec<[f64; 2]>>>,
+    /// Random particles: each particle's micro-moduli residual ‖a·A + b·B − D‖/‖D‖ (NaN
+    /// where no fit exists), for the VTK file.
+    pub moduli_residual: Option<Vec<f64>>,
     pub records: Vec<Record>,
     /// Spatial dimension of the run (2 or 3).
     pub dim: usize,
@@ -176,8 +195,8 @@ pub(super) struct Finished<'a> {
     pub failure: Option<String>,
 }
 
-pub(super) fn summarise(
-    p: &Prepared,
+pub(super) fn summarise<const K: usize>(
+    p: &Prepared<K>,
     run: &Finished,
     damage: Option<&[ParticleDamage]>,
 ) -> Summary {
@@ -296,6 +315,16 @@ pub(super) fn summarise(
         force_lag: p.model.scene.solver.force_lag,
         kernel,
         surface_correction: p.model.surface.clone(),
+        random_particles: p.model.random.as_ref().map(|r| RandomReport {
+            min_distance: p
+                .model
+                .scene
+                .discretisation
+                .min_distance
+                .unwrap_or(crate::discretise::random::DEFAULT_MIN_DISTANCE),
+            generation: r.generation.clone(),
+            micro_moduli: r.moduli.clone(),
+        }),
         micro_modulus_a_bulk: p.model.bulk.a,
         micro_modulus_b_bulk: p.model.bulk.b,
         spacing_m: d.spacing,

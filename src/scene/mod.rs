@@ -167,11 +167,17 @@ pub enum BodySpec {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DiscretisationSpec {
-    /// "hexagonal" (2D SPLM). Later: "fcc", "random".
+    /// "hexagonal" (2D SPLM) or "random" (SPPM: random Voronoi-weighted particles,
+    /// `discretise::random`).
     #[serde(default = "default_lattice")]
     pub lattice: String,
-    /// Nearest-neighbour spacing L0 (m).
+    /// Nearest-neighbour spacing L0 (m); for random particles the mean spacing: the particle
+    /// density of a hexagonal lattice of this L0.
     pub spacing: f64,
+    /// Random particles: the smallest distance between two particles, as a fraction of
+    /// `spacing` (default `discretise::random::DEFAULT_MIN_DISTANCE`).
+    #[serde(default)]
+    pub min_distance: Option<f64>,
     /// Lattice rotation about the origin, degrees.
     #[serde(default)]
     pub rotation_deg: f64,
@@ -721,11 +727,13 @@ impl Scene {
     /// The seed of the scene's random choices: `seed`, else [`DEFAULT_SEED`] if the scene
     /// makes any (random fields), else `None`.
     pub fn effective_seed(&self) -> Option<u64> {
-        self.seed.or(if self.random_field.is_empty() {
-            None
-        } else {
-            Some(DEFAULT_SEED)
-        })
+        self.seed.or(
+            if self.random_field.is_empty() && self.discretisation.lattice != "random" {
+                None
+            } else {
+                Some(DEFAULT_SEED)
+            },
+        )
     }
 }
 

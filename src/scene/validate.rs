@@ -85,11 +85,42 @@ impl Scene {
         self.validate_body()?;
         super::random_fields::check(self)?;
         let d = &self.discretisation;
-        if d.lattice != "hexagonal" {
+        if d.lattice != "hexagonal" && d.lattice != "random" {
             return Err(invalid(
                 "discretisation.lattice",
                 format!("{:?}", d.lattice),
-                "\"hexagonal\" (2D SPLM); \"fcc\" and \"random\" are not available yet",
+                "\"hexagonal\" (2D SPLM) or \"random\" (SPPM: random Voronoi-weighted particles); \"fcc\" is not available yet",
+            ));
+        }
+        if d.lattice == "random" {
+            if let Some(f) = d.min_distance {
+                if !(f.is_finite() && (0.5..=0.75).contains(&f)) {
+                    return Err(invalid(
+                        "discretisation.min_distance",
+                        f,
+                        "a fraction of the spacing in [0.5, 0.75]: the elastic calibration of random particles is measured there (model::sppm_calibration), and above 0.75 random placement can hardly reach a hexagonal lattice's density (the jamming limit of random sequential packing is about 0.78)",
+                    ));
+                }
+            }
+            if d.rotation_deg != 0.0 || d.offset != [0.0, 0.0] {
+                return Err(invalid(
+                    "discretisation.rotation_deg / discretisation.offset",
+                    format!("{} / {:?}", d.rotation_deg, d.offset),
+                    "0 and [0, 0] for lattice = \"random\": a random particle set has no orientation or origin (change `seed` for another particle set)",
+                ));
+            }
+            if d.surface_correction {
+                return Err(invalid(
+                    "discretisation.surface_correction",
+                    "true",
+                    "false (or absent) for lattice = \"random\": every random particle gets its own least-squares micro-moduli already",
+                ));
+            }
+        } else if let Some(f) = d.min_distance {
+            return Err(invalid(
+                "discretisation.min_distance",
+                f,
+                "absent for lattice = \"hexagonal\" (it sets the random particles' spacing rule)",
             ));
         }
         positive("discretisation.spacing", d.spacing)?;

@@ -216,10 +216,14 @@ where
 {
     let mut out = [None; K];
     let mut theta = 0.0;
+    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
     for (k, o) in out.iter_mut().enumerate() {
         *o = slot::<D, K, L, FULL>(m, c, x, i, k);
         if let Some(s) = o {
-            theta += s.sd * s.se;
+            theta += match w {
+                Some(w) => w[k] * (s.sd * s.se),
+                None => s.sd * s.se,
+            };
         }
     }
     (out, dilatation_term(m.b[i], theta))
@@ -252,6 +256,7 @@ where
     // The damaged elastic stretches equal the total ones (undamaged bonds, no plastic
     // stretch): one strain fit serves both.
     let mut same = true;
+    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
     for k in 0..K {
         cache[k] = match slot::<D, K, L, FULL>(m, c, x, i, k) {
             Some(s) => {
@@ -260,8 +265,16 @@ where
                 se[k] = s.se;
                 dse[k] = s.d * s.se;
                 used[k] = true;
-                theta += s.sd * s.se;
-                theta_e += s.se;
+                match w {
+                    Some(w) => {
+                        theta += w[k] * (s.sd * s.se);
+                        theta_e += w[k] * s.se;
+                    }
+                    None => {
+                        theta += s.sd * s.se;
+                        theta_e += s.se;
+                    }
+                }
                 same &= dse[k] == st[k];
                 SlotCache {
                     e: s.e,

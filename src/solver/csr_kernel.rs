@@ -717,6 +717,7 @@ mod tests {
             mass,
             c_in,
             c_ex,
+            dilatation_weight: None,
         };
         let mut st = State::at_rest(&x0);
         for i in 0..n {

@@ -95,7 +95,8 @@ pub const fn bond_cache_at(i: usize, k: usize, slots: usize) -> usize {
     (i / LANES) * (2 * LANES * slots) + 2 * LANES * k + i % LANES
 }
 
-/// b_i·Σ_m S_im for particle i (scalar; chunk tails and reference).
+/// b_i·θ_i, θ_i = Σ_m w_im·S_im (w = 1 without weights), for particle i (scalar; chunk tails
+/// and reference).
 #[inline(always)]
 fn dilatation_one<const D: usize, const K: usize>(
     m: &Mechanics<D, K>,
@@ -105,6 +106,7 @@ fn dilatation_one<const D: usize, const K: usize>(
     let xi = x[i];
     let nb = &m.neighbours[i];
     let il = &m.inv_l0[i];
+    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
     let mut s = 0.0;
     for k in 0..K {
         let j = nb[k];
@@ -113,7 +115,11 @@ fn dilatation_one<const D: usize, const K: usize>(
         }
         // SAFETY: Mechanics::new checks every occupied slot indexes a particle.
         let xj = unsafe { *x.get_unchecked(j as usize) };
-        s += total_stretch((xj - xi).norm(), il[k]);
+        let st = total_stretch((xj - xi).norm(), il[k]);
+        s += match w {
+            Some(w) => w[k] * st,
+            None => st,
+        };
     }
     dilatation_term(m.b[i], s)
 }
@@ -132,6 +138,7 @@ fn dilatation_one_cached<const D: usize, const K: usize>(
     let xi = x[i];
     let nb = &m.neighbours[i];
     let il = &m.inv_l0[i];
+    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
     let mut s = 0.0;
     for k in 0..K {
         let at = bond_cache_at(i - base, k, K);
@@ -147,7 +154,10 @@ fn dilatation_one_cached<const D: usize, const K: usize>(
         let st = total_stretch(len, il[k]);
         cache[at] = st;
         cache[at + LANES] = 1.0 / len;
-        s += st;
+        s += match w {
+            Some(w) => w[k] * st,
+            None => st,
+        };
     }
     dilatation_term(m.b[i], s)
 }
@@ -212,7 +222,8 @@ pub fn pass_dilatation<const D: usize, const K: usize>(
     out: &mut [f64],
 ) {
     assert!(x.len() == m.len() && out.len() == m.len());
-    let avx = use_avx();
+    // the AVX block sums unweighted stretches: weighted bodies take the scalar path
+    let avx = use_avx() && m.dilatation_weight.is_none();
     let chunk = chunk_len(out.len());
     out.par_chunks_mut(chunk)
         .enumerate()
@@ -231,7 +242,8 @@ fn pass_dilatation_cached<const D: usize, const K: usize>(
 ) {
     assert!(x.len() == m.len() && out.len() == m.len());
     assert!(cache.len() == bond_cache_len(m.len(), K));
-    let avx = use_avx();
+    // the AVX block sums unweighted stretches: weighted bodies take the scalar path
+    let avx = use_avx() && m.dilatation_weight.is_none();
     let chunk = chunk_len(out.len());
     debug_assert!(chunk.is_multiple_of(LANES));
     out.par_chunks_mut(chunk)
@@ -993,6 +1005,7 @@ mod tests {
             mass,
             c_in,
             c_ex,
+            dilatation_weight: None,
         };
         let mut st = State::at_rest(&x0);
         for i in 0..n {

@@ -37,7 +37,8 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
         (n.dot(&(u[j] - u[i])) * il, n)
     }
 
-    /// Internal forces f(u) of the linearised model; `theta` holds Σ_m S_im afterwards.
+    /// Internal forces f(u) of the linearised model; `theta` holds θ_i = Σ_m w_im·S_im
+    /// afterwards.
     pub fn internal_forces(&mut self, u: &[SVector<f64, D>], f: &mut [SVector<f64, D>]) {
         let mech = self.mech;
         let this = &*self;
@@ -46,7 +47,10 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
             .with_min_len(1024)
             .map(|i| {
                 mech.bonds(i)
-                    .map(|(_, j, il)| this.stretch(u, i, j, il).0)
+                    .map(|(k, j, il)| match &mech.dilatation_weight {
+                        Some(w) => w[i][k] * this.stretch(u, i, j, il).0,
+                        None => this.stretch(u, i, j, il).0,
+                    })
                     .sum()
             })
             .collect();

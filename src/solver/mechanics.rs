@@ -21,6 +21,9 @@ pub struct Mechanics<const D: usize, const K: usize> {
     pub c_in: Vec<f64>,
     /// Particle damper coefficient C_ex,i = 2·m_i·ξ_ex·ω_struct (3.56).
     pub c_ex: Vec<f64>,
+    /// Per-slot weight L0,ik/ℓ_i of the dilatation θ_i = Σ_k w_ik·S_ik where the body asks
+    /// for it (random particles, [`Particles::weighted_dilatation`]); `None`: θ_i = Σ_k S_ik.
+    pub dilatation_weight: Option<Vec<[f64; K]>>,
 }
 
 impl<const D: usize, const K: usize> Mechanics<D, K> {
@@ -48,6 +51,19 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
                 })
                 .collect();
         let mass: Vec<f64> = (0..n).map(|i| rho[i] * p.volume[i]).collect();
+        let dilatation_weight = p.weighted_dilatation.then(|| {
+            (0..n)
+                .map(|i| {
+                    let mut w = [0.0; K];
+                    for k in 0..K {
+                        if p.neighbours[i][k] != NONE {
+                            w[k] = p.l0[i][k] / p.length[i];
+                        }
+                    }
+                    w
+                })
+                .collect()
+        });
         Mechanics {
             neighbours: p.neighbours.clone(),
             inv_l0,
@@ -57,7 +73,37 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             mass,
             c_in: vec![0.0; n],
             c_ex: vec![0.0; n],
+            dilatation_weight,
         }
+    }
+
+    /// The dilatation weight of slot k of particle i (1 without weights).
+    #[inline(always)]
+    pub fn weight(&self, i: usize, k: usize) -> f64 {
+        match &self.dilatation_weight {
+            Some(w) => w[i][k],
+            None => 1.0,
+        }
+    }
+
+    /// θ_i = Σ_k w_ik·S_ik from the stretches of particle i's slots (0 in empty slots): the
+    /// plain sum without weights, so lattices keep their bits.
+    #[inline(always)]
+    pub fn dilatation(&self, i: usize, stretch: &[f64; K]) -> f64 {
+        let mut s = 0.0;
+        match &self.dilatation_weight {
+            Some(w) => {
+                for k in 0..K {
+                    s += w[i][k] * stretch[k];
+                }
+            }
+            None => {
+                for st in stretch {
+                    s += st;
+                }
+            }
+        }
+        s
     }
 
     pub fn len(&self) -> usize {
@@ -86,7 +132,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
     /// Upper bound of the spectral radius of M⁻¹K of the linearised model (the induced
     /// block-row-sum norm, a Gershgorin bound), with each block bounded by its 2-norm.
     /// Derivation: f_i = Σ_j ½((a_i+a_j)S_ij + b_i θ_i + b_j θ_j)·n_ij with
-    /// S_ij = n_ij·(u_j − u_i)/L_ij and θ_i = Σ_m S_im.
+    /// S_ij = n_ij·(u_j − u_i)/L_ij and θ_i = Σ_m w_im·S_im.
     pub fn max_eigenvalue_bound(&self, x0: &[SVector<f64, D>]) -> f64 {
         let n = self.len();
         // |Σ_m n_im / L_im| and Σ_m 1/L_im per particle
@@ -96,11 +142,12 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
         for i in 0..n {
             let mut s = SVector::<f64, D>::zeros();
             let mut sn = SVector::<f64, D>::zeros();
-            for (_, j, il) in self.bonds(i) {
+            for (k, j, il) in self.bonds(i) {
                 let e = (x0[j] - x0[i]) * il;
-                s += e * il;
+                let w = self.weight(i, k);
+                s += e * (il * w);
                 sn += e;
-                sum_inv_l[i] += il;
+                sum_inv_l[i] += il * w;
             }
             sum_n_over_l[i] = s.norm();
             sum_n[i] = sn.norm();

@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 use nalgebra::{Matrix3, Vector2, Vector3};
-use sppm::run::Model as Prepared;
+use sppm::run::Model;
+/// The hexagonal lattice's model (most tests).
+pub type Prepared = Model<6>;
 use sppm::solver::linear::LinearOperator;
 use sppm::solver::modal::static_response;
 use sppm::Scene;
@@ -65,7 +67,7 @@ pub fn scene(toml: &str) -> Scene {
 }
 
 /// Prescribed displacement field at full load.
-pub fn full_load(p: &Prepared) -> Vec<Vector2<f64>> {
+pub fn full_load<const K: usize>(p: &Model<K>) -> Vec<Vector2<f64>> {
     let mut u = vec![Vector2::zeros(); p.particles.len()];
     for pr in &p.prescribed {
         u[pr.particle as usize][pr.component as usize] = pr.amplitude;
@@ -74,12 +76,12 @@ pub fn full_load(p: &Prepared) -> Vec<Vector2<f64>> {
 }
 
 /// Static small-strain response to the full prescribed displacements.
-pub fn static_solution(p: &Prepared) -> Vec<Vector2<f64>> {
+pub fn static_solution<const K: usize>(p: &Model<K>) -> Vec<Vector2<f64>> {
     static_response(&p.mech, &p.particles.x0, &p.constrained, &full_load(p)).expect("static solve")
 }
 
 /// Reaction along y of a group for displacements u (linearised forces).
-pub fn reaction_y(p: &Prepared, u: &[Vector2<f64>], group: &str) -> f64 {
+pub fn reaction_y<const K: usize>(p: &Model<K>, u: &[Vector2<f64>], group: &str) -> f64 {
     let mut op = LinearOperator::new(&p.mech, &p.particles.x0);
     let mut f = vec![Vector2::zeros(); u.len()];
     op.internal_forces(u, &mut f);
@@ -112,7 +114,12 @@ pub fn fit_gradient(
 
 /// E and ν of a plate measured as an engineer would: σ = F/(W·t), strains fitted over the
 /// middle half of the plate (away from edges and grips).
-pub fn measure_e_nu(p: &Prepared, width: f64, height: f64, thickness: f64) -> (f64, f64) {
+pub fn measure_e_nu<const K: usize>(
+    p: &Model<K>,
+    width: f64,
+    height: f64,
+    thickness: f64,
+) -> (f64, f64) {
     let u = static_solution(p);
     let f = reaction_y(p, &u, "top");
     let cx = 0.5 * width;
