@@ -11,8 +11,8 @@
 //! summed in particle order; its golden value was recorded with f185737 plus only that change
 //! (0.8149639805052893 J; every other number of every scene was unchanged by it).
 //!
-//! The uniaxial tension block also runs on one thread: the thread count must not change
-//! results.
+//! The uniaxial tension block (lattice and random particles) also runs on one thread: the
+//! thread count must not change results.
 
 mod common;
 
@@ -73,6 +73,15 @@ const GOLDEN: &[Golden] = &[
         dissipated_energy_j: 1.7863414068707248,
         steps: 71923,
         particles: 543,
+    },
+    // Random particles (issue 13), recorded when the scene was added (commit after 958e0cc);
+    // the same numbers on 1 and 2 threads.
+    Golden {
+        scene: "uniaxial_tension_random",
+        peak_force_n: 49949.38826456123,
+        dissipated_energy_j: 1.6915208801206236,
+        steps: 86385,
+        particles: 520,
     },
 ];
 
@@ -188,4 +197,14 @@ fn golden_uniaxial_tension() {
 #[test]
 fn golden_uniaxial_tension_one_thread() {
     check("uniaxial_tension", "1");
+}
+
+#[test]
+fn golden_uniaxial_tension_random() {
+    check("uniaxial_tension_random", "2");
+}
+
+#[test]
+fn golden_uniaxial_tension_random_one_thread() {
+    check("uniaxial_tension_random", "1");
 }

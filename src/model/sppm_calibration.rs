@@ -11,8 +11,9 @@
 //! W/L0 = 50), so the moduli are fitted to the pair (E*, ν*) that the measured map sends to
 //! the scene's (E, ν).
 //!
-//! The table is the mean of 8 particle sets of a 100 × 200 mm plate at L0 = 2 mm in plane
-//! stress, per minimum distance and fitted in-plane ν*: (ν*, E/E*, ν). Regenerate it with
+//! The table holds, per minimum distance and fitted in-plane ν*, the mean (ν*, E/E*, ν) of a
+//! 100 × 200 mm plate: for the default 0.7 over 10 particle sets at L0 = 1 mm (W/L0 = 100),
+//! for 0.5, 0.6 and 0.75 over 8 sets at L0 = 2 mm. Regenerate it with
 //! `cargo test --release --test sppm_elastic -- --ignored --nocapture calibration_table`.
 //! Plane strain uses the same in-plane map (the 2D model sees only in-plane constants:
 //! E' = E/(1−ν²), ν' = ν/(1−ν)).

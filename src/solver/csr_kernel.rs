@@ -718,6 +718,7 @@ mod tests {
             c_in,
             c_ex,
             dilatation_weight: None,
+            slot_end: vec![0; n],
         };
         let mut st = State::at_rest(&x0);
         for i in 0..n {

@@ -222,8 +222,7 @@ pub fn pass_dilatation<const D: usize, const K: usize>(
     out: &mut [f64],
 ) {
     assert!(x.len() == m.len() && out.len() == m.len());
-    // the AVX block sums unweighted stretches: weighted bodies take the scalar path
-    let avx = use_avx() && m.dilatation_weight.is_none();
+    let avx = use_avx();
     let chunk = chunk_len(out.len());
     out.par_chunks_mut(chunk)
         .enumerate()
@@ -242,8 +241,7 @@ fn pass_dilatation_cached<const D: usize, const K: usize>(
 ) {
     assert!(x.len() == m.len() && out.len() == m.len());
     assert!(cache.len() == bond_cache_len(m.len(), K));
-    // the AVX block sums unweighted stretches: weighted bodies take the scalar path
-    let avx = use_avx() && m.dilatation_weight.is_none();
+    let avx = use_avx();
     let chunk = chunk_len(out.len());
     debug_assert!(chunk.is_multiple_of(LANES));
     out.par_chunks_mut(chunk)
@@ -647,6 +645,17 @@ pub(crate) mod avx {
         )
     }
 
+    /// The slots a block of particles i0..i0+4 needs: one past the last occupied slot of any
+    /// of them (the slots after it are empty in every lane and add nothing).
+    ///
+    /// # Safety
+    /// i0 + 4 ≤ m.len().
+    #[inline(always)]
+    unsafe fn block_slots<const D: usize, const K: usize>(m: &Mechanics<D, K>, i0: usize) -> usize {
+        let e = |l: usize| *m.slot_end.get_unchecked(i0 + l) as usize;
+        e(0).max(e(1)).max(e(2)).max(e(3))
+    }
+
     /// Neighbours in slot k of particles i0..i0+4 (the particle itself where the slot is
     /// empty) and the occupancy mask (all ones where occupied).
     #[target_feature(enable = "avx")]
@@ -688,7 +697,8 @@ pub(crate) mod avx {
         (d, _mm256_sqrt_pd(l2))
     }
 
-    /// b_i·Σ_m S_im for particles i0..i0+4 into out[0..4]; with `CACHE`, also each slot's
+    /// b_i·θ_i (θ_i = Σ_m w_im·S_im, w = 1 without weights) for particles i0..i0+4 into
+    /// out[0..4]; with `CACHE`, also each slot's
     /// stretch and inverse length (both 0 where the slot is empty) into the block's part of
     /// the bond cache at `cache` (see `super::bond_cache_at`).
     ///
@@ -707,7 +717,7 @@ pub(crate) mod avx {
         let one = _mm256_set1_pd(1.0);
         let xi = load_own(x, i0);
         let mut s = _mm256_setzero_pd();
-        for k in 0..K {
+        for k in 0..block_slots(m, i0) {
             let (j, occ, il) = slot(m, i0, k);
             let (_, len) = geometry(&xi, &gather_vec(x, &j));
             // total_stretch: len·(1/L0) − 1
@@ -717,7 +727,15 @@ pub(crate) mod avx {
                 _mm256_storeu_pd(cache.add(2 * LANES * k), st);
                 _mm256_storeu_pd(cache.add(2 * LANES * k + LANES), rinv);
             }
-            s = _mm256_add_pd(s, st);
+            // weighted dilatation (random particles): w·S, as the scalar path
+            let term = match &m.dilatation_weight {
+                Some(w) => {
+                    let wk = |l: usize| *w.get_unchecked(i0 + l).get_unchecked(k);
+                    _mm256_mul_pd(_mm256_set_pd(wk(3), wk(2), wk(1), wk(0)), st)
+                }
+                None => st,
+            };
+            s = _mm256_add_pd(s, term);
         }
         let b = _mm256_loadu_pd(m.b.as_ptr().add(i0));
         _mm256_storeu_pd(out, _mm256_mul_pd(b, s));
@@ -763,7 +781,7 @@ pub(crate) mod avx {
         };
         let mut f = [_mm256_setzero_pd(); D];
         let mut power = _mm256_setzero_pd();
-        for k in 0..K {
+        for k in 0..block_slots(m, i0) {
             let (j, occ, il) = slot(m, i0, k);
             let xj = gather_vec(x, &j);
             let (d, rinv, st) = if CACHE {
@@ -996,6 +1014,7 @@ mod tests {
         for c in c_ex.iter_mut().step_by(3) {
             *c = 0.0;
         }
+        let slot_end = crate::solver::mechanics::slot_end(&neighbours);
         let mech = Mechanics {
             neighbours,
             inv_l0,
@@ -1006,6 +1025,7 @@ mod tests {
             c_in,
             c_ex,
             dilatation_weight: None,
+            slot_end,
         };
         let mut st = State::at_rest(&x0);
         for i in 0..n {
@@ -1018,8 +1038,32 @@ mod tests {
 
     /// The kernel against the plain per-particle code, bit for bit, on 1 and 2 threads.
     fn check<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>() {
+        check_weighted::<D, K, LAG, DAMP>(false);
+    }
+
+    /// [`check`]; with `weighted`, the body weighs its dilatations (random particles).
+    fn check_weighted<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
+        weighted: bool,
+    ) {
         let n = 2 * CHUNK + 4 * 37 + 3;
-        let (m, st0) = model::<D, K>(n);
+        let (mut m, st0) = model::<D, K>(n);
+        if weighted {
+            let mut r = 0.37f64;
+            m.dilatation_weight = Some(
+                (0..n)
+                    .map(|i| {
+                        std::array::from_fn(|k| {
+                            r = (r * 3.9 * (1.0 - r)).clamp(0.01, 0.99);
+                            if m.neighbours[i][k] == crate::discretise::NONE {
+                                0.0
+                            } else {
+                                0.6 + r
+                            }
+                        })
+                    })
+                    .collect(),
+            );
+        }
         let dt = 1e-7;
         let mut want = st0.clone();
         for i in 0..n {
@@ -1081,5 +1125,8 @@ mod tests {
         check::<2, 6, true, false>();
         check::<3, 18, false, true>();
         check::<3, 18, true, false>();
+        // weighted dilatation (random particles) on the AVX and scalar paths
+        check_weighted::<2, 12, false, true>(true);
+        check_weighted::<2, 12, true, false>(true);
     }
 }

@@ -24,6 +24,17 @@ pub struct Mechanics<const D: usize, const K: usize> {
     /// Per-slot weight L0,ik/ℓ_i of the dilatation θ_i = Σ_k w_ik·S_ik where the body asks
     /// for it (random particles, [`Particles::weighted_dilatation`]); `None`: θ_i = Σ_k S_ik.
     pub dilatation_weight: Option<Vec<[f64; K]>>,
+    /// One past each particle's last occupied slot: the AVX blocks stop at the largest of
+    /// their four (random particles fill 6–11 of 12 slots).
+    pub slot_end: Vec<u8>,
+}
+
+/// One past the last occupied slot of each particle.
+pub fn slot_end<const K: usize>(neighbours: &[[u32; K]]) -> Vec<u8> {
+    neighbours
+        .iter()
+        .map(|s| s.iter().rposition(|&j| j != NONE).map_or(0, |k| k + 1) as u8)
+        .collect()
 }
 
 impl<const D: usize, const K: usize> Mechanics<D, K> {
@@ -54,13 +65,13 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
         let dilatation_weight = p.weighted_dilatation.then(|| {
             (0..n)
                 .map(|i| {
-                    let mut w = [0.0; K];
-                    for k in 0..K {
+                    std::array::from_fn(|k| {
                         if p.neighbours[i][k] != NONE {
-                            w[k] = p.l0[i][k] / p.length[i];
+                            p.l0[i][k] / p.length[i]
+                        } else {
+                            0.0
                         }
-                    }
-                    w
+                    })
                 })
                 .collect()
         });
@@ -74,6 +85,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             c_in: vec![0.0; n],
             c_ex: vec![0.0; n],
             dilatation_weight,
+            slot_end: slot_end(&p.neighbours),
         }
     }
 
@@ -84,26 +96,6 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             Some(w) => w[i][k],
             None => 1.0,
         }
-    }
-
-    /// θ_i = Σ_k w_ik·S_ik from the stretches of particle i's slots (0 in empty slots): the
-    /// plain sum without weights, so lattices keep their bits.
-    #[inline(always)]
-    pub fn dilatation(&self, i: usize, stretch: &[f64; K]) -> f64 {
-        let mut s = 0.0;
-        match &self.dilatation_weight {
-            Some(w) => {
-                for k in 0..K {
-                    s += w[i][k] * stretch[k];
-                }
-            }
-            None => {
-                for st in stretch {
-                    s += st;
-                }
-            }
-        }
-        s
     }
 
     pub fn len(&self) -> usize {
