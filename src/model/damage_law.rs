@@ -86,6 +86,10 @@ where
     pub b_theta_elastic: f64,
     /// Every particle's length scale L0,i (m; read through [`ParticleBonds::length`]).
     pub lengths: &'a [f64],
+    /// The strain the criteria (initiation, yield) read instead of the particle's own damaged
+    /// elastic strain, where the kernel averages it over the particle's neighbourhood
+    /// (random particles; `solver::concrete`); `None`: the particle's own.
+    pub criteria_strain: Option<&'a crate::model::dimension::Tensor<D>>,
 }
 
 impl<const D: usize, const K: usize> ParticleBonds<'_, D, K>

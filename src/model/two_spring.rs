@@ -112,10 +112,10 @@ where
         let eps = Dim::<D>::strain_tensor(b.fit, b.total);
         // The criteria stress D·ε_d, needed only to test initiation and yield.
         let criteria_stress = || {
-            let eps_d = if b.undamaged {
-                eps
-            } else {
-                Dim::<D>::strain_tensor(b.fit, b.damaged)
+            let eps_d = match b.criteria_strain {
+                Some(e) => *e,
+                None if b.undamaged => eps,
+                None => Dim::<D>::strain_tensor(b.fit, b.damaged),
             };
             // D is linear in E: a particle's own E scales the law's D.
             Dim::<D>::stress_of_strain(&(self.d * (law.e / self.law.e)), &eps_d)

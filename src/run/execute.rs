@@ -87,7 +87,10 @@ pub fn build_simulation<const K: usize>(p: &mut Prepared<K>) -> Simulation<2, K>
     );
     if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
         let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
-        let c: Concrete<2, K> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
+        let mut c: Concrete<2, K> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
+        if p.model.random.is_some() {
+            c = c.with_neighbourhood_criteria(&p.model.particles);
+        }
         sim.inelastic = Some(Box::new(c));
     }
     sim
