@@ -426,7 +426,8 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
             );
         }
     }
-    if base.random_field.is_empty() {
+    // random particles draw a new particle set per realisation from its seed
+    if base.random_field.is_empty() && base.discretisation.lattice != "random" {
         eprintln!(
             "warning: {} has no [[random_field]]: every realisation of a size is the same run",
             args.scene.display()
