@@ -135,6 +135,7 @@ pub fn bench(
                 spacing: l0,
                 min_distance: random::DEFAULT_MIN_DISTANCE,
                 seed: 1,
+                rotation_deg: 0.0,
                 thickness: 0.1,
             };
             let (mut p, _, g) = random::fill::<{ random::SLOTS_2D }>(&shape, &recipe)

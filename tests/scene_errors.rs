@@ -381,9 +381,9 @@ fn random_particle_keys() {
     says(&msg, &["discretisation.min_distance", "hexagonal"]);
     let msg = error_of(&[
         "discretisation.lattice=\"random\"",
-        "discretisation.rotation_deg=15",
+        "discretisation.offset=[0.001, 0.0]",
     ]);
-    says(&msg, &["rotation_deg", "15", "random"]);
+    says(&msg, &["discretisation.offset", "0.001", "random"]);
     let msg = error_of(&[
         "discretisation.lattice=\"random\"",
         "discretisation.surface_correction=true",

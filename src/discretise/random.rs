@@ -53,9 +53,11 @@ pub struct RandomParticles {
     /// Minimum distance between particles as a fraction of `spacing`.
     pub min_distance: f64,
     pub seed: u64,
-    /// Rotation (degrees) of the whole particle set about the body's centre after generation
-    /// is not offered: a random set has no direction. The objectivity study rotates the
-    /// load instead.
+    /// Rotation (degrees) of the interior's random stream about the centre of the body's
+    /// box: the candidates of angle θ are those of angle 0 (drawn in the box of the body
+    /// turned by −θ) turned by θ, so a set at θ is the set of the same seed rotated against
+    /// the body and its loads (the objectivity study). 0: candidates in the body's own box.
+    pub rotation_deg: f64,
     pub thickness: f64,
 }
 
@@ -215,6 +217,16 @@ pub fn place(shape: &Shape2, recipe: &RandomParticles) -> Result<(Vec<P>, usize)
     }
     let on_outline = x.len();
     let mut rng = ChaCha20Rng::seed_from_u64(recipe.seed);
+    // the frame of the candidates: the body's box (θ = 0), or the box of the body turned by −θ
+    let centre = (lo + hi) * 0.5;
+    let (sin, cos) = recipe.rotation_deg.to_radians().sin_cos();
+    let turn = |v: P, s: f64| P::new(cos * v.x - s * v.y, s * v.x + cos * v.y);
+    let (mut flo, mut fhi) = (P::repeat(f64::INFINITY), P::repeat(f64::NEG_INFINITY));
+    for corner in [lo, hi, P::new(lo.x, hi.y), P::new(hi.x, lo.y)] {
+        let q = turn(corner - centre, -sin);
+        flo = flo.inf(&q);
+        fhi = fhi.sup(&q);
+    }
     let tol = 1e-9 * shape.size();
     let max_attempts = 1000 * target.max(16) as u64;
     let mut attempts = 0u64;
@@ -229,10 +241,18 @@ pub fn place(shape: &Shape2, recipe: &RandomParticles) -> Result<(Vec<P>, usize)
                 recipe.min_distance
             ));
         }
-        let p = P::new(
-            lo.x + (hi.x - lo.x) * uniform(&mut rng),
-            lo.y + (hi.y - lo.y) * uniform(&mut rng),
-        );
+        let p = if recipe.rotation_deg == 0.0 {
+            P::new(
+                lo.x + (hi.x - lo.x) * uniform(&mut rng),
+                lo.y + (hi.y - lo.y) * uniform(&mut rng),
+            )
+        } else {
+            let q = P::new(
+                flo.x + (fhi.x - flo.x) * uniform(&mut rng),
+                flo.y + (fhi.y - flo.y) * uniform(&mut rng),
+            );
+            centre + turn(q, sin)
+        };
         if shape.contains(&p, -tol) && grid.free(&p, delta, &x) {
             grid.insert(&p, x.len() as u32);
             x.push(p);
@@ -393,6 +413,7 @@ mod tests {
             spacing: 0.005,
             min_distance: DEFAULT_MIN_DISTANCE,
             seed,
+            rotation_deg: 0.0,
             thickness: 0.1,
         }
     }

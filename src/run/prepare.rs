@@ -148,6 +148,7 @@ fn discretise<const K: usize>(
             spacing: d.spacing,
             min_distance: d.min_distance.unwrap_or(random::DEFAULT_MIN_DISTANCE),
             seed: scene.seed.unwrap_or(crate::scene::DEFAULT_SEED),
+            rotation_deg: d.rotation_deg,
             thickness: scene.material.thickness,
         };
         let (p, cells, generation) = random::fill::<K>(shape, &recipe).map_err(|e| {

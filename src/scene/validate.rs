@@ -102,11 +102,11 @@ impl Scene {
                     ));
                 }
             }
-            if d.rotation_deg != 0.0 || d.offset != [0.0, 0.0] {
+            if d.offset != [0.0, 0.0] {
                 return Err(invalid(
-                    "discretisation.rotation_deg / discretisation.offset",
-                    format!("{} / {:?}", d.rotation_deg, d.offset),
-                    "0 and [0, 0] for lattice = \"random\": a random particle set has no orientation or origin (change `seed` for another particle set)",
+                    "discretisation.offset",
+                    format!("{:?}", d.offset),
+                    "[0, 0] for lattice = \"random\": a random particle set has no origin (change `seed` for another particle set; rotation_deg turns the set against the body)",
                 ));
             }
             if d.surface_correction {

@@ -19,7 +19,8 @@ pub enum StudyCommand {
         /// Lattice rotations in degrees, comma-separated.
         #[arg(long, default_value = "0,15,30,45")]
         angles: String,
-        /// Random lattice offsets per angle, besides the scene's own offset.
+        /// Random lattice offsets per angle, besides the scene's own offset (random particles:
+        /// further particle sets per angle, besides the scene's own seed).
         #[arg(long, default_value_t = 0)]
         offsets: usize,
         /// Seed of the random offsets (recorded in objectivity.csv and objectivity.json).

@@ -7,6 +7,11 @@
 //! scene's offset, with a1, a2 the rotated lattice vectors and (u, v) uniform in [0, 1)²
 //! drawn from `seed` and k alone. The same (u, v) is used at every angle, so that adding an
 //! angle or an offset leaves the other runs (and their rows) unchanged.
+//!
+//! On random particles (SPPM) "offset" k is realisation k: the particle set of seed
+//! [`realisation_seed`] (k = 0: the scene's own), turned by each angle against the body
+//! (`discretise::random`). objectivity.json reports, per angle, the mean and the coefficient
+//! of variation of the peak force and the energy over the realisations.
 
 use super::crack_path::{crack_core, crack_path, mean_axis_deg};
 use super::runner::{RunResult, Study, Variant};
@@ -34,6 +39,17 @@ pub struct ObjectivityArgs {
     pub out: Option<PathBuf>,
     pub jobs: usize,
     pub progress: bool,
+}
+
+/// The particle-set seed of realisation `k` of a study of random particles: the scene's seed
+/// for k = 0, else a SplitMix64 hash of the study seed and k (the same at every angle, so each
+/// angle turns the same particle sets).
+pub fn realisation_seed(study_seed: u64, scene_seed: u64, k: usize) -> u64 {
+    if k == 0 {
+        scene_seed
+    } else {
+        splitmix64(splitmix64(study_seed) ^ k as u64) >> 1
+    }
 }
 
 /// The fractional position (u, v) in [0, 1)² of random offset `k` (k ≥ 1) for `seed`.
@@ -162,6 +178,9 @@ pub struct AngleSummary {
     pub mean_peak_force_n: f64,
     #[serde(rename = "mean_dissipated_energy_J")]
     pub mean_dissipated_energy_j: f64,
+    /// Coefficient of variation (sample) of the peak force and of the energy over the runs.
+    pub cov_peak_force: Option<f64>,
+    pub cov_dissipated_energy: Option<f64>,
     /// Mean axes over the offsets: the doubled-angle mean ([`mean_axis_deg`]).
     pub mean_crack_axis_deg: Option<f64>,
     pub mean_crack_centroid_x_m: Option<f64>,
@@ -248,9 +267,24 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     let count = args.angles_deg.len() as u128 * per_angle_runs;
     let spacing = d.spacing;
     let scene_offset = d.offset;
+    // random particles: "offset" k is realisation k, a particle set of its own seed (k = 0:
+    // the scene's seed), turned by the angle
+    let random = d.lattice == "random";
+    let scene_seed = base.seed.unwrap_or(crate::scene::DEFAULT_SEED);
     let make = |j: usize| {
         let (i, k) = (j as u128 / per_angle_runs, j as u128 % per_angle_runs);
         let (a, k) = (args.angles_deg[i as usize], k as usize);
+        if random {
+            let seed = realisation_seed(args.seed, scene_seed, k);
+            return Variant {
+                label: label(a, k),
+                overrides: vec![
+                    format!("discretisation.rotation_deg={a:?}"),
+                    format!("seed={seed}"),
+                ],
+                tags: vec![a.to_string(), k.to_string(), seed.to_string()],
+            };
+        }
         let off = lattice_offset(args.seed, k, a, spacing, scene_offset);
         Variant {
             label: label(a, k),
@@ -335,6 +369,14 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
         (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
     };
+    let cov_of = |v: Vec<f64>| {
+        let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+        (v.len() >= 2).then(|| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+            var.sqrt() / m.abs()
+        })
+    };
     let per_angle = args
         .angles_deg
         .iter()
@@ -352,6 +394,10 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
                     rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
                 )
                 .unwrap_or(f64::NAN),
+                cov_peak_force: cov_of(rs.iter().map(|r| r.row.peak_force_n).collect()),
+                cov_dissipated_energy: cov_of(
+                    rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
+                ),
                 mean_crack_axis_deg: mean_axis_deg(
                     &rs.iter()
                         .map(|r| metric(r, "crack_axis_deg"))
