@@ -142,22 +142,13 @@ pub fn bench(
                 .map_err(|e| anyhow::anyhow!("random particles: {e}"))?;
             let t = Instant::now();
             let d = micro_modulus::elasticity_matrix(30e9, 0.2, Plane::Stress);
-            let n = p.len();
-            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-            for i in 0..n {
-                let bonds: Vec<(Vector2<f64>, f64)> = (0..random::SLOTS_2D)
-                    .filter(|&k| p.neighbours[i][k] != crate::discretise::NONE)
-                    .map(|k| {
-                        let j = p.neighbours[i][k] as usize;
-                        ((p.x0[j] - p.x0[i]).normalize(), p.l0[i][k])
-                    })
-                    .collect();
-                let f =
-                    crate::model::dimension::fit_weighted_2d(&bonds, p.volume[i], p.length[i], &d)
-                        .ok_or_else(|| anyhow::anyhow!("particle {i} has no moduli fit"))?;
-                a[i] = f.moduli.a;
-                b[i] = f.moduli.b;
-            }
+            let (mut a, mut b) = (std::mem::take(&mut p.a), std::mem::take(&mut p.b));
+            let fit = crate::run::prepare::fit_moduli(&p, &d, &mut a, &mut b);
+            anyhow::ensure!(
+                fit.unfitted == 0,
+                "{} particles have no moduli fit",
+                fit.unfitted
+            );
             p.a = a;
             p.b = b;
             let setup = Setup {

@@ -40,6 +40,13 @@ impl HexLattice {
     /// (across a notch or a re-entrant corner) are not made; particles left with no bond are
     /// dropped.
     pub fn fill(&self, shape: &Shape2) -> Particles<2, 6> {
+        self.fill_slots(shape)
+    }
+
+    /// [`Self::fill`] into K ≥ 6 slots (the six lattice directions first, the rest empty),
+    /// for a pipeline that runs the lattice in the slot count of another discretisation.
+    pub fn fill_slots<const K: usize>(&self, shape: &Shape2) -> Particles<2, K> {
+        const { assert!(K >= 6, "a hexagonal lattice needs six slots") };
         let (a1, a2) = self.vectors();
         // The same lattice with the offset reduced to within a cell of the origin, so that an
         // offset of many cells does not cost the positions their precision.
@@ -54,7 +61,7 @@ impl HexLattice {
         lattice.fill_reduced(shape)
     }
 
-    fn fill_reduced(&self, shape: &Shape2) -> Particles<2, 6> {
+    fn fill_reduced<const K: usize>(&self, shape: &Shape2) -> Particles<2, K> {
         let (a1, a2) = self.vectors();
         let (lo, hi) = shape.bounding_box();
         let tol = 1e-9 * shape.size().max(self.spacing);
@@ -85,9 +92,9 @@ impl HexLattice {
             }
         }
         let n = x0.len();
-        let mut neighbours = vec![[NONE; 6]; n];
-        let mut reverse = vec![[0u8; 6]; n];
-        let mut l0 = vec![[0.0; 6]; n];
+        let mut neighbours = vec![[NONE; K]; n];
+        let mut reverse = vec![[0u8; K]; n];
+        let mut l0 = vec![[0.0; K]; n];
         for (p, &(i, j)) in coords.iter().enumerate() {
             for (k, (di, dj)) in STEPS.iter().enumerate() {
                 if let Some(&q) = index.get(&(i + di, j + dj)) {

@@ -119,6 +119,17 @@ impl<const D: usize, const K: usize> Particles<D, K> {
             / 2
     }
 
+    /// The bonds of particle i in the reference configuration: (unit direction, L0).
+    pub fn reference_bonds(&self, i: usize) -> Vec<(SVector<f64, D>, f64)> {
+        (0..K)
+            .filter(|&k| self.neighbours[i][k] != NONE)
+            .map(|k| {
+                let j = self.neighbours[i][k] as usize;
+                ((self.x0[j] - self.x0[i]).normalize(), self.l0[i][k])
+            })
+            .collect()
+    }
+
     /// Number of bonds of particle i.
     pub fn bond_count(&self, i: usize) -> usize {
         self.neighbours[i].iter().filter(|&&j| j != NONE).count()

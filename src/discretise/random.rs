@@ -61,9 +61,26 @@ pub struct RandomParticles {
     pub thickness: f64,
 }
 
+impl RandomParticles {
+    /// The recipe of a scene's `[discretisation]` (lattice = "random"), its seed and
+    /// thickness.
+    pub fn of_scene(scene: &crate::scene::Scene) -> Self {
+        let d = &scene.discretisation;
+        RandomParticles {
+            spacing: d.spacing,
+            min_distance: d.min_distance.unwrap_or(DEFAULT_MIN_DISTANCE),
+            seed: scene.seed.unwrap_or(crate::scene::DEFAULT_SEED),
+            rotation_deg: d.rotation_deg,
+            thickness: scene.material.thickness,
+        }
+    }
+}
+
 /// What generation measured (`sppm check`, summary.json).
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct Generation {
+    /// The minimum distance used (fraction of the spacing).
+    pub min_distance: f64,
     pub particles: usize,
     pub outline_particles: usize,
     /// Target count (the hexagonal lattice's density).
@@ -131,7 +148,7 @@ fn outline(shape: &Shape2) -> Vec<Piece> {
             ]
         }
         _ => {
-            let v = voronoi::straight_outline(shape).expect("straight-edged shape");
+            let v = shape.polygon().expect("straight-edged shape");
             (0..v.len())
                 .map(|i| Piece::Segment(v[i], v[(i + 1) % v.len()]))
                 .collect()
@@ -191,17 +208,24 @@ impl Grid {
     }
 }
 
+/// Particles a body of `shape` receives at mean spacing `l0`: as many as a hexagonal lattice
+/// of that spacing, area / ((√3/2)·L0²).
+pub fn target_count(shape: &Shape2, l0: f64) -> usize {
+    (shape.area() / (0.5 * 3f64.sqrt() * l0 * l0)).round() as usize
+}
+
 /// Uniform in [0, 1) from 53 random bits (the same on every platform).
 fn uniform(rng: &mut ChaCha20Rng) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// Place the particles: the outline, then the interior; then sort them in rows. Returns the
-/// positions and how many lie on the outline. `Err` when the body cannot hold the density at this minimum distance.
+/// positions and how many lie on the outline. `Err` when the body cannot hold the density
+/// at this minimum distance.
 pub fn place(shape: &Shape2, recipe: &RandomParticles) -> Result<(Vec<P>, usize), String> {
     let l0 = recipe.spacing;
     let delta = recipe.min_distance * l0;
-    let target = (shape.area() / (0.5 * 3f64.sqrt() * l0 * l0)).round() as usize;
+    let target = target_count(shape, l0);
     let (lo, hi) = shape.bounding_box();
     let mut grid = Grid::new(lo, hi, delta);
     let mut x: Vec<P> = Vec::with_capacity(target + 16);
@@ -241,6 +265,8 @@ pub fn place(shape: &Shape2, recipe: &RandomParticles) -> Result<(Vec<P>, usize)
                 recipe.min_distance
             ));
         }
+        // θ = 0 draws in the body's own box directly (the same candidates as the turned
+        // frame up to rounding; the recorded particle sets of the shipped scenes keep their bits)
         let p = if recipe.rotation_deg == 0.0 {
             P::new(
                 lo.x + (hi.x - lo.x) * uniform(&mut rng),
@@ -313,6 +339,7 @@ pub fn bond<const K: usize>(
         }
         for (k, &j) in l.iter().enumerate() {
             neighbours[i][k] = j;
+            // (x_j − x_i) is exactly −(x_i − x_j): both ends hold the same length bits
             l0[i][k] = (x[j as usize] - x[i]).norm();
         }
     }
@@ -327,16 +354,15 @@ pub fn bond<const K: usize>(
                 .iter()
                 .position(|&q| q == i as u32)
                 .expect("bond lists are symmetric");
-            // (x_j − x_i) is exactly −(x_i − x_j): both ends hold the same length bits
             reverse[i][k] = r as u8;
         }
     }
     Ok((neighbours, reverse, l0))
 }
 
-/// Generate a random body: particles, Voronoi volumes (× thickness), bonds; and what
-/// generation measured. Particles without bonds are dropped (with their cells' area lost;
-/// the count is in the generation report).
+/// Generate a random body: particles, Voronoi volumes (× thickness), bonds, each particle's
+/// length scale (its mean bond length); the cells; and what generation measured. A particle
+/// without a bond inside the body is an error.
 pub fn fill<const K: usize>(
     shape: &Shape2,
     recipe: &RandomParticles,
@@ -350,9 +376,27 @@ pub fn fill<const K: usize>(
     let t3 = std::time::Instant::now();
     let volume: Vec<f64> = cells.iter().map(|c| c.1 * recipe.thickness).collect();
     let polygons: Vec<Vec<P>> = cells.into_iter().map(|c| c.0).collect();
-    let target = (shape.area() / (0.5 * 3f64.sqrt() * recipe.spacing.powi(2))).round() as usize;
     let mut p = Particles::new(x, volume, neighbours, reverse, l0, recipe.spacing);
     p.weighted_dilatation = true;
+    if let Some(i) = (0..p.len()).find(|&i| p.bond_count(i) == 0) {
+        return Err(format!(
+            "particle {i} at ({:.6}, {:.6}) m has no bond inside the body (a sliver of the body thinner than the spacing); use a smaller discretisation.spacing",
+            p.x0[i].x, p.x0[i].y
+        ));
+    }
+    // The statistics, while `length` still holds each particle's shortest bond.
+    let mut hist = vec![0usize; K + 1];
+    let (mut nmin, mut nsum, mut nmax) = (f64::INFINITY, 0.0, 0.0f64);
+    for i in 0..p.len() {
+        hist[p.bond_count(i)] += 1;
+        let near = p.length[i] / recipe.spacing;
+        nmin = nmin.min(near);
+        nmax = nmax.max(near);
+        nsum += near;
+    }
+    while hist.last() == Some(&0) {
+        hist.pop();
+    }
     // A random particle's length scale is its mean bond length (the lattice's shortest bond
     // is its only one): ω_i and the crack band read it.
     for i in 0..p.len() {
@@ -363,36 +407,13 @@ pub fn fill<const K: usize>(
                 count += 1;
             }
         }
-        if count > 0 {
-            p.length[i] = sum / count as f64;
-        }
-    }
-    if let Some(i) = (0..p.len()).find(|&i| p.bond_count(i) == 0) {
-        return Err(format!(
-            "particle {i} at ({:.6}, {:.6}) m has no bond inside the body (a sliver of the body thinner than the spacing); use a smaller discretisation.spacing",
-            p.x0[i].x, p.x0[i].y
-        ));
-    }
-    let mut hist = vec![0usize; K + 1];
-    let (mut nmin, mut nsum, mut nmax) = (f64::INFINITY, 0.0, 0.0f64);
-    for i in 0..p.len() {
-        hist[p.bond_count(i)] += 1;
-        let shortest = (0..K)
-            .filter(|&k| p.neighbours[i][k] != NONE)
-            .map(|k| p.l0[i][k])
-            .fold(f64::INFINITY, f64::min);
-        let near = shortest / recipe.spacing;
-        nmin = nmin.min(near);
-        nmax = nmax.max(near);
-        nsum += near;
-    }
-    while hist.last() == Some(&0) {
-        hist.pop();
+        p.length[i] = sum / count as f64;
     }
     let generation = Generation {
+        min_distance: recipe.min_distance,
         particles: p.len(),
         outline_particles: on_outline,
-        target,
+        target: target_count(shape, recipe.spacing),
         nearest_min: nmin,
         nearest_mean: nsum / p.len() as f64,
         nearest_max: nmax,

@@ -9,22 +9,11 @@
 //! intersected with a disc. The clipped cells of a body sum to its area to rounding
 //! (tests: 1e-9 relative on a rectangle, a disc, the dog-bone and the notched beam).
 
-use crate::geometry::Shape2;
+use crate::geometry::{polygon_area, Shape2};
 use nalgebra::Vector2;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 type P = Vector2<f64>;
-
-/// Area (signed; positive counter-clockwise) of a polygon.
-fn signed_area(v: &[P]) -> f64 {
-    let n = v.len();
-    let mut s = 0.0;
-    for i in 0..n {
-        let (a, b) = (v[i], v[(i + 1) % n]);
-        s += a.x * b.y - b.x * a.y;
-    }
-    0.5 * s
-}
 
 /// Keep the part of polygon `poly` where n·x ≤ c (Sutherland–Hodgman against one half-plane;
 /// `poly` may be non-convex, the clipped area is exact).
@@ -124,56 +113,6 @@ fn triangle_disc_area(a: P, b: P, r: f64) -> f64 {
     }
 }
 
-/// The body's polygon for shapes bounded by straight edges (counter-clockwise), `None` for the
-/// disc and the dog-bone.
-pub fn straight_outline(shape: &Shape2) -> Option<Vec<P>> {
-    let mut v = match shape {
-        Shape2::Rectangle {
-            origin,
-            width,
-            height,
-        } => vec![
-            *origin,
-            origin + P::new(*width, 0.0),
-            origin + P::new(*width, *height),
-            origin + P::new(0.0, *height),
-        ],
-        Shape2::Polygon { vertices } => vertices.clone(),
-        Shape2::NotchedBeam {
-            length,
-            depth,
-            notch_depth,
-            notch_width,
-        } => {
-            let (l, h, nd, nw) = (*length, *depth, *notch_depth, *notch_width);
-            if nd > 0.0 && nw > 0.0 {
-                vec![
-                    P::new(0.0, 0.0),
-                    P::new(0.5 * (l - nw), 0.0),
-                    P::new(0.5 * (l - nw), nd),
-                    P::new(0.5 * (l + nw), nd),
-                    P::new(0.5 * (l + nw), 0.0),
-                    P::new(l, 0.0),
-                    P::new(l, h),
-                    P::new(0.0, h),
-                ]
-            } else {
-                vec![
-                    P::new(0.0, 0.0),
-                    P::new(l, 0.0),
-                    P::new(l, h),
-                    P::new(0.0, h),
-                ]
-            }
-        }
-        Shape2::Disc { .. } | Shape2::DogBone { .. } => return None,
-    };
-    if signed_area(&v) < 0.0 {
-        v.reverse();
-    }
-    Some(v)
-}
-
 /// Area of a convex polygon (counter-clockwise) within the body.
 pub fn area_in_body(cell: &[P], shape: &Shape2) -> f64 {
     if cell.len() < 3 {
@@ -182,7 +121,7 @@ pub fn area_in_body(cell: &[P], shape: &Shape2) -> f64 {
     match shape {
         Shape2::Disc { centre, radius } => {
             if cell.iter().all(|v| (v - centre).norm() <= *radius) {
-                signed_area(cell)
+                polygon_area(cell)
             } else {
                 convex_disc_area(cell, centre, *radius)
             }
@@ -201,7 +140,7 @@ pub fn area_in_body(cell: &[P], shape: &Shape2) -> f64 {
                 return 0.0;
             }
             let r = 0.725 * d;
-            let mut area = signed_area(&c);
+            let mut area = polygon_area(&c);
             for x in [-1.025 * d, 1.025 * d] {
                 let centre = P::new(x, 0.75 * d);
                 // only cells whose box meets the disc's box (disjoint cells would add a
@@ -222,8 +161,8 @@ pub fn area_in_body(cell: &[P], shape: &Shape2) -> f64 {
             area
         }
         _ => {
-            let outline = straight_outline(shape).expect("straight-edged shape");
-            signed_area(&clip_by_convex(&outline, cell)).abs()
+            let outline = shape.polygon().expect("straight-edged shape");
+            polygon_area(&clip_by_convex(&outline, cell)).abs()
         }
     }
 }
@@ -262,26 +201,19 @@ pub fn clipped_cells(x: &[P], shape: &Shape2) -> Result<Vec<(Vec<P>, f64)>, Stri
     for v in tri.vertices() {
         let i = v.fix().index();
         debug_assert_eq!(i, cells.len(), "bulk_load_stable keeps the order");
+        // the cell is cut in coordinates about x_i (for accuracy), then moved back once
         let xi = x[i];
         cur.clear();
-        cur.extend_from_slice(&bbox);
+        cur.extend(bbox.iter().map(|c| c - xi));
         for e in v.out_edges() {
-            let j = e.to().fix().index();
-            let xj = x[j];
-            // bisector: (xj − xi)·y ≤ (|xj|² − |xi|²)/2, written about xi for accuracy
-            let n = xj - xi;
-            let c = 0.5 * n.dot(&n);
-            for p in cur.iter_mut() {
-                *p -= xi;
-            }
-            clip_half_plane(&cur, &n, c, &mut next);
-            for p in next.iter_mut() {
-                *p += xi;
-            }
+            // bisector of x_i and x_j: (x_j − x_i)·y ≤ |x_j − x_i|²/2
+            let n = x[e.to().fix().index()] - xi;
+            clip_half_plane(&cur, &n, 0.5 * n.dot(&n), &mut next);
             std::mem::swap(&mut cur, &mut next);
         }
-        let area = area_in_body(&cur, shape);
-        cells.push((cur.clone(), area));
+        let cell: Vec<P> = cur.iter().map(|p| p + xi).collect();
+        let area = area_in_body(&cell, shape);
+        cells.push((cell, area));
     }
     Ok(cells)
 }

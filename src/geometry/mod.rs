@@ -95,6 +95,56 @@ impl Shape2 {
         }
     }
 
+    /// The body's polygon for shapes bounded by straight edges (counter-clockwise), `None` for the
+    /// disc and the dog-bone.
+    pub fn polygon(&self) -> Option<Vec<Vector2<f64>>> {
+        let mut v = match self {
+            Shape2::Rectangle {
+                origin,
+                width,
+                height,
+            } => vec![
+                *origin,
+                origin + Vector2::new(*width, 0.0),
+                origin + Vector2::new(*width, *height),
+                origin + Vector2::new(0.0, *height),
+            ],
+            Shape2::Polygon { vertices } => vertices.clone(),
+            Shape2::NotchedBeam {
+                length,
+                depth,
+                notch_depth,
+                notch_width,
+            } => {
+                let (l, h, nd, nw) = (*length, *depth, *notch_depth, *notch_width);
+                if nd > 0.0 && nw > 0.0 {
+                    vec![
+                        Vector2::new(0.0, 0.0),
+                        Vector2::new(0.5 * (l - nw), 0.0),
+                        Vector2::new(0.5 * (l - nw), nd),
+                        Vector2::new(0.5 * (l + nw), nd),
+                        Vector2::new(0.5 * (l + nw), 0.0),
+                        Vector2::new(l, 0.0),
+                        Vector2::new(l, h),
+                        Vector2::new(0.0, h),
+                    ]
+                } else {
+                    vec![
+                        Vector2::new(0.0, 0.0),
+                        Vector2::new(l, 0.0),
+                        Vector2::new(l, h),
+                        Vector2::new(0.0, h),
+                    ]
+                }
+            }
+            Shape2::Disc { .. } | Shape2::DogBone { .. } => return None,
+        };
+        if polygon_area(&v) < 0.0 {
+            v.reverse();
+        }
+        Some(v)
+    }
+
     /// Whether `p` lies in the closed shape (boundary included within `tol`).
     pub fn contains(&self, p: &Vector2<f64>, tol: f64) -> bool {
         match self {

@@ -33,9 +33,6 @@ const TABLE: [(f64, Rows); 4] = [
 
 include!("sppm_calibration_table.rs");
 
-/// The minimum distances the calibration covers.
-pub const MIN_DISTANCE_RANGE: (f64, f64) = (0.5, 0.75);
-
 /// The rows at minimum distance `md`, linear between the measured ones.
 fn rows_at(md: f64) -> Rows {
     let md = md.clamp(TABLE[0].0, TABLE[TABLE.len() - 1].0);

@@ -12,13 +12,14 @@ use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
 use crate::scene::{Scene, SolverMethod};
 use crate::solver::concrete::Concrete;
-use crate::solver::mechanics::Mechanics;
+use crate::solver::mechanics::{weighted, Mechanics};
 use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
 use nalgebra::{Matrix2, Vector2};
 use std::time::Instant;
 
 /// Particle stresses (3.18) at positions x: σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(e_ij ⊗ e_ij)
-/// with F_s,ij = a_i·S_ij + b_i·Σ_m S_im and e_ij the current bond direction.
+/// with F_s,ij = a_i·S_ij + b_i·θ_i (θ_i = Σ_m w_im·S_im, `Mechanics::weights`) and e_ij the
+/// current bond direction.
 pub fn particle_stress<const K: usize>(
     mech: &Mechanics<2, K>,
     volume: &[f64],
@@ -27,12 +28,9 @@ pub fn particle_stress<const K: usize>(
     (0..x.len())
         .map(|i| {
             let mut theta = 0.0;
+            let w = mech.weights(i);
             for (k, j, il) in mech.bonds(i) {
-                let s = total_stretch((x[j] - x[i]).norm(), il);
-                theta += match &mech.dilatation_weight {
-                    Some(w) => w[i][k] * s,
-                    None => s,
-                };
+                theta += weighted(w, k, total_stretch((x[j] - x[i]).norm(), il));
             }
             let mut acc = StressSum::default();
             for (_, j, il) in mech.bonds(i) {

@@ -3,7 +3,7 @@
 
 use super::RunError;
 use crate::discretise::random::{self, Generation, RandomParticles};
-use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles, NONE};
+use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
 use crate::limits::available_memory;
 use crate::material;
 use crate::material::properties::{self, SampledField};
@@ -96,7 +96,7 @@ pub struct Model<const K: usize = 6> {
 /// Bond slots the scene's discretisation needs: 6 for the hexagonal lattice,
 /// [`random::SLOTS_2D`] for random particles.
 pub fn slots_of(scene: &Scene) -> usize {
-    if scene.discretisation.lattice == "random" {
+    if scene.discretisation.is_random() {
         random::SLOTS_2D
     } else {
         6
@@ -140,17 +140,11 @@ fn discretise<const K: usize>(
             "discretisation.lattice = {:?} runs in {} bond slots, not {K} (use run::prepare_model{})",
             d.lattice,
             slots_of(scene),
-            if d.lattice == "random" { "_random" } else { "" }
+            if d.is_random() { "_random" } else { "" }
         )));
     }
-    if d.lattice == "random" {
-        let recipe = RandomParticles {
-            spacing: d.spacing,
-            min_distance: d.min_distance.unwrap_or(random::DEFAULT_MIN_DISTANCE),
-            seed: scene.seed.unwrap_or(crate::scene::DEFAULT_SEED),
-            rotation_deg: d.rotation_deg,
-            thickness: scene.material.thickness,
-        };
+    if d.is_random() {
+        let recipe = RandomParticles::of_scene(scene);
         let (p, cells, generation) = random::fill::<K>(shape, &recipe).map_err(|e| {
             RunError::Setup(format!(
                 "discretisation.spacing = {} (lattice = \"random\", min_distance = {}): {e}",
@@ -165,36 +159,7 @@ fn discretise<const K: usize>(
         offset: Vector2::new(d.offset[0], d.offset[1]),
         thickness: scene.material.thickness,
     };
-    Ok((reslot(lattice.fill(shape)), None))
-}
-
-/// A body in A slots moved to B ≥ (its largest bond count) slots.
-fn reslot<const A: usize, const B: usize>(p: Particles<2, A>) -> Particles<2, B> {
-    let n = p.len();
-    let mut neighbours = vec![[NONE; B]; n];
-    let mut reverse = vec![[0u8; B]; n];
-    let mut l0 = vec![[0.0; B]; n];
-    for i in 0..n {
-        for k in 0..A.min(B) {
-            neighbours[i][k] = p.neighbours[i][k];
-            reverse[i][k] = p.reverse[i][k];
-            l0[i][k] = p.l0[i][k];
-        }
-    }
-    Particles {
-        x0: p.x0,
-        volume: p.volume,
-        neighbours,
-        reverse,
-        l0,
-        horizon: p.horizon,
-        length: p.length,
-        a: p.a,
-        b: p.b,
-        c: p.c,
-        spacing: p.spacing,
-        weighted_dilatation: p.weighted_dilatation,
-    }
+    Ok((lattice.fill_slots(shape), None))
 }
 
 /// [`prepare_model`], telling `stage` what it starts (for `sppm check` of large bodies).
@@ -339,7 +304,7 @@ fn assemble<const K: usize>(
         if !d.surface_correction {
             continue;
         }
-        match micro_modulus::fit(&bond_list(&particles, i), particles.volume[i], &dmat) {
+        match micro_modulus::fit(&particles.reference_bonds(i), particles.volume[i], &dmat) {
             Some(f) => {
                 a[i] = f.moduli.a;
                 b[i] = f.moduli.b;
@@ -351,8 +316,8 @@ fn assemble<const K: usize>(
     }
     // Random particles: every particle's own least-squares constants (MODEL.md §3, (3.20)).
     let target = match (&random_body, calibrate) {
-        (Some(_), true) => {
-            let md = d.min_distance.unwrap_or(random::DEFAULT_MIN_DISTANCE);
+        (Some((_, generation)), true) => {
+            let md = generation.min_distance;
             let (e, nu) =
                 crate::model::sppm_calibration::fit_target(m.youngs_modulus(), m.nu, m.plane, md)
                     .map_err(|allowed| {
@@ -368,40 +333,7 @@ fn assemble<const K: usize>(
     };
     let random = random_body.map(|(cells, generation)| {
         stage("micro-moduli of every particle (least squares)");
-        let mut residual = vec![f64::NAN; n];
-        let mut unfitted = 0;
-        for i in 0..n {
-            let fit = crate::model::dimension::fit_weighted_2d(
-                &bond_list(&particles, i),
-                particles.volume[i],
-                particles.length[i],
-                &target,
-            );
-            match fit {
-                Some(f) => {
-                    a[i] = f.moduli.a;
-                    b[i] = f.moduli.b;
-                    residual[i] = f.residual;
-                }
-                None => unfitted += 1,
-            }
-        }
-        let mut fitted: Vec<f64> = residual.iter().copied().filter(|r| r.is_finite()).collect();
-        fitted.sort_by(f64::total_cmp);
-        let pick = |q: f64| {
-            if fitted.is_empty() {
-                f64::NAN
-            } else {
-                fitted[((q * (fitted.len() - 1) as f64).round() as usize).min(fitted.len() - 1)]
-            }
-        };
-        let moduli = ModuliFit {
-            residual_mean: fitted.iter().sum::<f64>() / fitted.len().max(1) as f64,
-            residual_p99: pick(0.99),
-            residual_max: pick(1.0),
-            residual,
-            unfitted,
-        };
+        let moduli = fit_moduli(&particles, &target, &mut a, &mut b);
         RandomBody {
             cells,
             generation,
@@ -443,15 +375,50 @@ fn assemble<const K: usize>(
     })
 }
 
-/// The bonds of particle i as (reference unit direction, reference length).
-fn bond_list<const K: usize>(p: &Particles<2, K>, i: usize) -> Vec<(Vector2<f64>, f64)> {
-    (0..K)
-        .filter(|&k| p.neighbours[i][k] != NONE)
-        .map(|k| {
-            let j = p.neighbours[i][k] as usize;
-            ((p.x0[j] - p.x0[i]).normalize(), p.l0[i][k])
-        })
-        .collect()
+/// Each random particle's least-squares (a_i, b_i) against the elasticity matrix `d` from its
+/// own bonds, with weighted dilatation ((3.20), MODEL.md §13), written into `a` and `b`;
+/// particles without a fit keep their entries. Returns the residual statistics.
+pub fn fit_moduli<const K: usize>(
+    particles: &Particles<2, K>,
+    d: &nalgebra::Matrix3<f64>,
+    a: &mut [f64],
+    b: &mut [f64],
+) -> ModuliFit {
+    let n = particles.len();
+    let mut residual = vec![f64::NAN; n];
+    let mut unfitted = 0;
+    for i in 0..n {
+        let fit = crate::model::dimension::fit_weighted_2d(
+            &particles.reference_bonds(i),
+            particles.volume[i],
+            particles.length[i],
+            d,
+        );
+        match fit {
+            Some(f) => {
+                a[i] = f.moduli.a;
+                b[i] = f.moduli.b;
+                residual[i] = f.residual;
+            }
+            None => unfitted += 1,
+        }
+    }
+    let mut fitted: Vec<f64> = residual.iter().copied().filter(|r| r.is_finite()).collect();
+    fitted.sort_by(f64::total_cmp);
+    let pick = |q: f64| {
+        if fitted.is_empty() {
+            f64::NAN
+        } else {
+            fitted[((q * (fitted.len() - 1) as f64).round() as usize).min(fitted.len() - 1)]
+        }
+    };
+    ModuliFit {
+        residual_mean: fitted.iter().sum::<f64>() / fitted.len().max(1) as f64,
+        residual_p99: pick(0.99),
+        residual_max: pick(1.0),
+        residual,
+        unfitted,
+    }
 }
 
 /// A failed modal analysis, with the scene keys T1 depends on.

@@ -106,8 +106,6 @@ pub struct Summary {
 /// What a random body reports in summary.json.
 #[derive(Clone, Debug, Serialize)]
 pub struct RandomReport {
-    /// Minimum distance between particles (fraction of the spacing).
-    pub min_distance: f64,
     pub generation: crate::discretise::random::Generation,
     pub micro_moduli: super::prepare::ModuliFit,
 }
@@ -316,12 +314,6 @@ pub(super) fn summarise<const K: usize>(
         kernel,
         surface_correction: p.model.surface.clone(),
         random_particles: p.model.random.as_ref().map(|r| RandomReport {
-            min_distance: p
-                .model
-                .scene
-                .discretisation
-                .min_distance
-                .unwrap_or(crate::discretise::random::DEFAULT_MIN_DISTANCE),
             generation: r.generation.clone(),
             micro_moduli: r.moduli.clone(),
         }),

@@ -194,6 +194,13 @@ pub struct DiscretisationSpec {
     pub surface_correction: bool,
 }
 
+impl DiscretisationSpec {
+    /// Whether the body is random particles (SPPM) rather than a lattice.
+    pub fn is_random(&self) -> bool {
+        self.lattice == "random"
+    }
+}
+
 fn default_lattice() -> String {
     "hexagonal".into()
 }
@@ -728,7 +735,7 @@ impl Scene {
     /// makes any (random fields), else `None`.
     pub fn effective_seed(&self) -> Option<u64> {
         self.seed.or(
-            if self.random_field.is_empty() && self.discretisation.lattice != "random" {
+            if self.random_field.is_empty() && !self.discretisation.is_random() {
                 None
             } else {
                 Some(DEFAULT_SEED)

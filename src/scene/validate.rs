@@ -92,7 +92,7 @@ impl Scene {
                 "\"hexagonal\" (2D SPLM) or \"random\" (SPPM: random Voronoi-weighted particles); \"fcc\" is not available yet",
             ));
         }
-        if d.lattice == "random" {
+        if d.is_random() {
             if let Some(f) = d.min_distance {
                 if !(f.is_finite() && (0.5..=0.75).contains(&f)) {
                     return Err(invalid(

@@ -32,12 +32,12 @@
 //! law for each bond's damage factor and each particle's new state, and moves the particles.
 
 use super::kernel::central_difference;
-use super::mechanics::Mechanics;
+use super::mechanics::{weighted, Mechanics};
 use super::KernelSet;
 use crate::discretise::{Particles, NONE};
 pub use crate::model::damage_law::ParticleDamage;
 use crate::model::damage_law::{DamageLaw, Kernel, ParticleBonds};
-use crate::model::dimension::{Dim, Dimension};
+use crate::model::dimension::{Dim, Dimension, Tensor};
 use crate::model::force_state::{
     bond_energy, damaged_axial, damaged_bond_force, damaged_force_state, dilatation_term,
 };
@@ -91,8 +91,8 @@ where
 pub struct Neighbourhood<const D: usize> {
     volume: Vec<f64>,
     /// Committed damaged elastic strain of every particle (previous step).
-    strain: Vec<crate::model::dimension::Tensor<D>>,
-    strain_trial: Vec<crate::model::dimension::Tensor<D>>,
+    strain: Vec<Tensor<D>>,
+    strain_trial: Vec<Tensor<D>>,
 }
 
 impl<const D: usize, const K: usize, L: DamageLaw<D, K>> Concrete<D, K, L>
@@ -134,8 +134,8 @@ where
         let n = p.len();
         self.neighbourhood = Some(Neighbourhood {
             volume: p.volume.clone(),
-            strain: vec![crate::model::dimension::Tensor::<D>::zeros(); n],
-            strain_trial: vec![crate::model::dimension::Tensor::<D>::zeros(); n],
+            strain: vec![Tensor::<D>::zeros(); n],
+            strain_trial: vec![Tensor::<D>::zeros(); n],
         });
         self
     }
@@ -253,14 +253,11 @@ where
 {
     let mut out = [None; K];
     let mut theta = 0.0;
-    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
+    let w = m.weights(i);
     for (k, o) in out.iter_mut().enumerate() {
         *o = slot::<D, K, L, FULL>(m, c, x, i, k);
         if let Some(s) = o {
-            theta += match w {
-                Some(w) => w[k] * (s.sd * s.se),
-                None => s.sd * s.se,
-            };
+            theta += weighted(w, k, s.sd * s.se);
         }
     }
     (out, dilatation_term(m.b[i], theta))
@@ -281,7 +278,7 @@ fn update_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: 
     trial: &mut L::State,
     sps_trial: &mut [f64; K],
     cache: &mut [SlotCache<D>; K],
-    own_strain: Option<&mut crate::model::dimension::Tensor<D>>,
+    own_strain: Option<&mut Tensor<D>>,
 ) -> f64
 where
     Dim<D>: Dimension<D>,
@@ -296,7 +293,7 @@ where
     // The damaged elastic stretches equal the total ones (undamaged bonds, no plastic
     // stretch): one strain fit serves both.
     let mut same = true;
-    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
+    let w = m.weights(i);
     for k in 0..K {
         cache[k] = match slot::<D, K, L, FULL>(m, c, x, i, k) {
             Some(s) => {
@@ -305,16 +302,8 @@ where
                 se[k] = s.se;
                 dse[k] = s.d * s.se;
                 used[k] = true;
-                match w {
-                    Some(w) => {
-                        theta += w[k] * (s.sd * s.se);
-                        theta_e += w[k] * s.se;
-                    }
-                    None => {
-                        theta += s.sd * s.se;
-                        theta_e += s.se;
-                    }
-                }
+                theta += weighted(w, k, s.sd * s.se);
+                theta_e += weighted(w, k, s.se);
                 same &= dse[k] == st[k];
                 SlotCache {
                     e: s.e,

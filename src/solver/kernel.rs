@@ -19,7 +19,7 @@
 //! bonds. `LAG = true` is the literal reading (A) of MODEL.md §4: the force from the previous
 //! step's positions drives this step.
 
-use super::mechanics::Mechanics;
+use super::mechanics::{weighted, Mechanics};
 use crate::model::force_state::{bond_force, dilatation_term};
 use crate::model::stretch::total_stretch;
 use nalgebra::SVector;
@@ -106,7 +106,7 @@ fn dilatation_one<const D: usize, const K: usize>(
     let xi = x[i];
     let nb = &m.neighbours[i];
     let il = &m.inv_l0[i];
-    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
+    let w = m.weights(i);
     let mut s = 0.0;
     for k in 0..K {
         let j = nb[k];
@@ -115,11 +115,7 @@ fn dilatation_one<const D: usize, const K: usize>(
         }
         // SAFETY: Mechanics::new checks every occupied slot indexes a particle.
         let xj = unsafe { *x.get_unchecked(j as usize) };
-        let st = total_stretch((xj - xi).norm(), il[k]);
-        s += match w {
-            Some(w) => w[k] * st,
-            None => st,
-        };
+        s += weighted(w, k, total_stretch((xj - xi).norm(), il[k]));
     }
     dilatation_term(m.b[i], s)
 }
@@ -138,7 +134,7 @@ fn dilatation_one_cached<const D: usize, const K: usize>(
     let xi = x[i];
     let nb = &m.neighbours[i];
     let il = &m.inv_l0[i];
-    let w = m.dilatation_weight.as_ref().map(|w| &w[i]);
+    let w = m.weights(i);
     let mut s = 0.0;
     for k in 0..K {
         let at = bond_cache_at(i - base, k, K);
@@ -154,10 +150,7 @@ fn dilatation_one_cached<const D: usize, const K: usize>(
         let st = total_stretch(len, il[k]);
         cache[at] = st;
         cache[at + LANES] = 1.0 / len;
-        s += match w {
-            Some(w) => w[k] * st,
-            None => st,
-        };
+        s += weighted(w, k, st);
     }
     dilatation_term(m.b[i], s)
 }
@@ -1048,16 +1041,17 @@ mod tests {
         let n = 2 * CHUNK + 4 * 37 + 3;
         let (mut m, st0) = model::<D, K>(n);
         if weighted {
-            let mut r = 0.37f64;
+            // L0,ik/ℓ_i of random particles lies about 0.6–1.6
+            let mut r = Lcg(7);
             m.dilatation_weight = Some(
                 (0..n)
                     .map(|i| {
                         std::array::from_fn(|k| {
-                            r = (r * 3.9 * (1.0 - r)).clamp(0.01, 0.99);
-                            if m.neighbours[i][k] == crate::discretise::NONE {
+                            let w = 0.6 + r.next();
+                            if m.neighbours[i][k] == NONE {
                                 0.0
                             } else {
-                                0.6 + r
+                                w
                             }
                         })
                     })

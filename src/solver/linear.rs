@@ -3,7 +3,7 @@
 //! f_i = Σ_j ½((a_i + a_j)·S_ij + b_i·θ_i + b_j·θ_j)·n_ij (MODEL.md §3–4 linearised).
 //! Used for the fundamental period and for the patch test at round-off accuracy.
 
-use super::mechanics::Mechanics;
+use super::mechanics::{weighted, Mechanics};
 use crate::model::force_state::{bond_force, dilatation_term, force_state};
 use nalgebra::SVector;
 use rayon::prelude::*;
@@ -46,11 +46,9 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
             .into_par_iter()
             .with_min_len(1024)
             .map(|i| {
+                let w = mech.weights(i);
                 mech.bonds(i)
-                    .map(|(k, j, il)| match &mech.dilatation_weight {
-                        Some(w) => w[i][k] * this.stretch(u, i, j, il).0,
-                        None => this.stretch(u, i, j, il).0,
-                    })
+                    .map(|(k, j, il)| weighted(w, k, this.stretch(u, i, j, il).0))
                     .sum()
             })
             .collect();

@@ -29,6 +29,16 @@ pub struct Mechanics<const D: usize, const K: usize> {
     pub slot_end: Vec<u8>,
 }
 
+/// w_k·s for a row of [`Mechanics::weights`]; s itself without weights, so that the lattices
+/// keep their bits. Every sum θ_i = Σ_k w_ik·S_ik goes through it.
+#[inline(always)]
+pub fn weighted<const K: usize>(w: Option<&[f64; K]>, k: usize, s: f64) -> f64 {
+    match w {
+        Some(w) => w[k] * s,
+        None => s,
+    }
+}
+
 /// One past the last occupied slot of each particle.
 pub fn slot_end<const K: usize>(neighbours: &[[u32; K]]) -> Vec<u8> {
     neighbours
@@ -89,13 +99,10 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
         }
     }
 
-    /// The dilatation weight of slot k of particle i (1 without weights).
+    /// Particle i's row of dilatation weights; `None` without weights (see [`weighted`]).
     #[inline(always)]
-    pub fn weight(&self, i: usize, k: usize) -> f64 {
-        match &self.dilatation_weight {
-            Some(w) => w[i][k],
-            None => 1.0,
-        }
+    pub fn weights(&self, i: usize) -> Option<&[f64; K]> {
+        self.dilatation_weight.as_ref().map(|w| &w[i])
     }
 
     pub fn len(&self) -> usize {
@@ -134,12 +141,13 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
         for i in 0..n {
             let mut s = SVector::<f64, D>::zeros();
             let mut sn = SVector::<f64, D>::zeros();
+            let w = self.weights(i);
             for (k, j, il) in self.bonds(i) {
                 let e = (x0[j] - x0[i]) * il;
-                let w = self.weight(i, k);
-                s += e * (il * w);
+                let wil = weighted(w, k, il);
+                s += e * wil;
                 sn += e;
-                sum_inv_l[i] += il * w;
+                sum_inv_l[i] += wil;
             }
             sum_n_over_l[i] = s.norm();
             sum_n[i] = sn.norm();

@@ -458,12 +458,10 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 let mut sum_s = 0.0;
                 let mut sum_s2_l = 0.0;
                 let mut sum_s_l = 0.0;
+                let w = m.weights(i);
                 for (k, j, il) in m.bonds(i) {
                     let s = crate::model::stretch::total_stretch((x[j] - x[i]).norm(), il);
-                    sum_s += match &m.dilatation_weight {
-                        Some(w) => w[i][k] * s,
-                        None => s,
-                    };
+                    sum_s += mechanics::weighted(w, k, s);
                     sum_s2_l += s * s / il;
                     sum_s_l += s / il;
                 }

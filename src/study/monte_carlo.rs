@@ -427,7 +427,7 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
         }
     }
     // random particles draw a new particle set per realisation from its seed
-    if base.random_field.is_empty() && base.discretisation.lattice != "random" {
+    if base.random_field.is_empty() && !base.discretisation.is_random() {
         eprintln!(
             "warning: {} has no [[random_field]]: every realisation of a size is the same run",
             args.scene.display()

@@ -269,8 +269,8 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     let scene_offset = d.offset;
     // random particles: "offset" k is realisation k, a particle set of its own seed (k = 0:
     // the scene's seed), turned by the angle
-    let random = d.lattice == "random";
-    let scene_seed = base.seed.unwrap_or(crate::scene::DEFAULT_SEED);
+    let random = d.is_random();
+    let scene_seed = crate::discretise::random::RandomParticles::of_scene(&base).seed;
     let make = |j: usize| {
         let (i, k) = (j as u128 / per_angle_runs, j as u128 % per_angle_runs);
         let (a, k) = (args.angles_deg[i as usize], k as usize);
@@ -371,11 +371,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     };
     let cov_of = |v: Vec<f64>| {
         let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
-        (v.len() >= 2).then(|| {
-            let m = v.iter().sum::<f64>() / v.len() as f64;
-            let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
-            var.sqrt() / m.abs()
-        })
+        (v.len() >= 2).then(|| super::size_effect::sample(&v).cov)
     };
     let per_angle = args
         .angles_deg
