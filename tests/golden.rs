@@ -76,11 +76,13 @@ const GOLDEN: &[Golden] = &[
     },
     // Random particles (issue 13), the same numbers on 1 and 2 threads. Re-recorded when the
     // Voronoi cells were cut about their particle in one frame (the volumes moved in their
-    // last bits; peak −6e-11 relative, energy +4e-13).
+    // last bits; peak −6e-11 relative, energy +4e-13), and again when damaged neighbours
+    // left the criteria's neighbourhood mean (solver::concrete::Neighbourhood: peak 58.51 →
+    // 56.53 kN, energy 1.771 → 1.911 J for this set; over 10 sets the energy fell).
     Golden {
         scene: "uniaxial_tension_random",
-        peak_force_n: 58507.152195914634,
-        dissipated_energy_j: 1.771236870911107,
+        peak_force_n: 56527.41410812431,
+        dissipated_energy_j: 1.9107950082404672,
         steps: 86458,
         particles: 520,
     },

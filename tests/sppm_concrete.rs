@@ -1,6 +1,6 @@
 //! SPPM (random particles, issue 13): the Table 1 tension block
 //! (`lattices/uniaxial_tension_random.toml`) over five particle sets. Its peak must lie within
-//! ±5% of f't·A in the mean (the issue's acceptance; measured 0.997 over seeds 1–5, 0.991 over
+//! ±5% of f't·A in the mean (the issue's acceptance; measured 0.981 over seeds 1–5, 0.977 over
 //! 1–10), and every crack must run across the block perpendicular to the load: the cracked
 //! particles (w_t ≥ 0.99) span the block's width, and each crack (cracked particles grouped
 //! where their heights leave a gap of more than 30 mm) stays within a band of half the
