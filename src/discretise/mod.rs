@@ -50,7 +50,7 @@ pub struct Particles<const D: usize, const K: usize> {
     /// rows. Per-particle quantities use [`Self::length`].
     pub spacing: f64,
     /// Whether the dilatation of particle i weighs each bond by L0,im/ℓ_i (ℓ_i =
-    /// [`Self::length`]): θ_i = Σ_m (L0,im/ℓ_i)·S_im. Random particles need it (MODEL.md §13,
+    /// [`Self::length`]): θ_i = Σ_m (L0,im/ℓ_i)·S_im. Random particles need it (docs/sppm.md,
     /// "dilatation of unequal bonds"); on a lattice every weight would be 1, so it is off.
     pub weighted_dilatation: bool,
 }

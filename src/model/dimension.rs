@@ -257,7 +257,7 @@ pub fn stiffness_basis<const D: usize, const V: usize, L: Layout<D, V>>(
 }
 
 /// [`stiffness_basis`] of a particle whose dilatation weighs bond m by L0,m/ℓ
-/// (`ell = Some(ℓ)`; random particles, MODEL.md §13): B = (M·1)(wᵀN), symmetric. `None`:
+/// (`ell = Some(ℓ)`; random particles, docs/sppm.md): B = (M·1)(wᵀN), symmetric. `None`:
 /// the unweighted θ = Σ S of the lattices.
 pub fn stiffness_basis_weighted<const D: usize, const V: usize, L: Layout<D, V>>(
     bonds: &[(Vector<D>, f64)],

@@ -376,7 +376,7 @@ fn assemble<const K: usize>(
 }
 
 /// Each random particle's least-squares (a_i, b_i) against the elasticity matrix `d` from its
-/// own bonds, with weighted dilatation ((3.20), MODEL.md §13), written into `a` and `b`;
+/// own bonds, with weighted dilatation ((3.20), docs/sppm.md), written into `a` and `b`;
 /// particles without a fit keep their entries. Returns the residual statistics.
 pub fn fit_moduli<const K: usize>(
     particles: &Particles<2, K>,
