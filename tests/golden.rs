@@ -60,6 +60,14 @@ const GOLDEN: &[Golden] = &[
         steps: 42090,
         particles: 823,
     },
+    // Random particles at L0 = 3.5 mm (issue 13), the same numbers on 1 and 2 threads.
+    Golden {
+        scene: "split_cylinder_random",
+        peak_force_n: 250607.02904670624,
+        dissipated_energy_j: 6.7765355743359255,
+        steps: 71666,
+        particles: 1666,
+    },
     Golden {
         scene: "uniaxial_compression",
         peak_force_n: 503506.53319232847,
@@ -185,6 +193,11 @@ fn golden_elastic_plate() {
 #[test]
 fn golden_split_cylinder() {
     check("split_cylinder", "2");
+}
+
+#[test]
+fn golden_split_cylinder_random() {
+    check("split_cylinder_random", "2");
 }
 
 #[test]
