@@ -9,7 +9,7 @@
 //! intersected with a disc. The clipped cells of a body sum to its area to rounding
 //! (tests: 1e-9 relative on a rectangle, a disc, the dog-bone and the notched beam).
 
-use crate::geometry::{polygon_area, Shape2};
+use crate::geometry::{dogbone_arcs, points_box, polygon_area, Shape2};
 use nalgebra::Vector2;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
@@ -139,17 +139,12 @@ pub fn area_in_body(cell: &[P], shape: &Shape2) -> f64 {
             if c.len() < 3 {
                 return 0.0;
             }
-            let r = 0.725 * d;
+            let (r, centres) = dogbone_arcs(d);
             let mut area = polygon_area(&c);
-            for x in [-1.025 * d, 1.025 * d] {
-                let centre = P::new(x, 0.75 * d);
-                // only cells whose box meets the disc's box (disjoint cells would add a
-                // rounding-size zero)
-                let (mut lo, mut hi) = (c[0], c[0]);
-                for v in &c {
-                    lo = lo.inf(v);
-                    hi = hi.sup(v);
-                }
+            // only cells whose box meets a disc's box (disjoint cells would add a
+            // rounding-size zero)
+            let (lo, hi) = points_box(&c);
+            for centre in centres {
                 if lo.x < centre.x + r
                     && hi.x > centre.x - r
                     && lo.y < centre.y + r
@@ -167,8 +162,10 @@ pub fn area_in_body(cell: &[P], shape: &Shape2) -> f64 {
     }
 }
 
-/// Each particle's Voronoi cell clipped to the body (the cell polygon, counter-clockwise, and
-/// its area), from the Delaunay triangulation of the particles. `Err` names what failed
+/// Each particle's Voronoi cell clipped to the body (the clipped polygon, counter-clockwise,
+/// and its area), from the Delaunay triangulation of the particles. The area is exact
+/// ([`area_in_body`]); the polygon, for drawing, follows arcs in the chords of
+/// [`Shape2::outline_polygon`]. `Err` names what failed
 /// (fewer than three particles, coincident or collinear particles).
 pub fn clipped_cells(x: &[P], shape: &Shape2) -> Result<Vec<(Vec<P>, f64)>, String> {
     if x.len() < 3 {
@@ -195,6 +192,7 @@ pub fn clipped_cells(x: &[P], shape: &Shape2) -> Result<Vec<(Vec<P>, f64)>, Stri
         P::new(hi.x + pad.x, hi.y + pad.y),
         P::new(lo.x - pad.x, hi.y + pad.y),
     ];
+    let body = shape.outline_polygon();
     let mut cells = Vec::with_capacity(x.len());
     let mut cur = Vec::with_capacity(16);
     let mut next = Vec::with_capacity(16);
@@ -213,7 +211,14 @@ pub fn clipped_cells(x: &[P], shape: &Shape2) -> Result<Vec<(Vec<P>, f64)>, Stri
         }
         let cell: Vec<P> = cur.iter().map(|p| p + xi).collect();
         let area = area_in_body(&cell, shape);
-        cells.push((cell, area));
+        // cells of particles at the surface reach beyond it (their area in the body is less
+        // than their own): cut them to the body
+        let drawn = if area >= (1.0 - 1e-12) * polygon_area(&cell) {
+            cell
+        } else {
+            clip_by_convex(&body, &cell)
+        };
+        cells.push((drawn, area));
     }
     Ok(cells)
 }

@@ -42,15 +42,7 @@ impl Shape2 {
                 width,
                 height,
             } => (*origin, origin + Vector2::new(*width, *height)),
-            Shape2::Polygon { vertices } => {
-                let mut lo = Vector2::repeat(f64::INFINITY);
-                let mut hi = Vector2::repeat(f64::NEG_INFINITY);
-                for v in vertices {
-                    lo = lo.inf(v);
-                    hi = hi.sup(v);
-                }
-                (lo, hi)
-            }
+            Shape2::Polygon { vertices } => points_box(vertices),
             Shape2::Disc { centre, radius } => (
                 centre - Vector2::repeat(*radius),
                 centre + Vector2::repeat(*radius),
@@ -145,6 +137,58 @@ impl Shape2 {
         Some(v)
     }
 
+    /// The outline as pieces, counter-clockwise (edges, and the arcs of the disc and the
+    /// dog-bone).
+    pub fn outline(&self) -> Vec<Piece> {
+        use std::f64::consts::PI;
+        type P = Vector2<f64>;
+        match self {
+            Shape2::Disc { centre, radius } => vec![Piece::Arc(*centre, *radius, 0.0, 2.0 * PI)],
+            Shape2::DogBone { size } => {
+                let d = *size;
+                let (r, [cl, cr]) = dogbone_arcs(d);
+                let ang = |c: P, p: P| (p.y - c.y).atan2(p.x - c.x);
+                let (r0, r1) = (P::new(0.5 * d, 0.25 * d), P::new(0.5 * d, 1.25 * d));
+                let (l0, l1) = (P::new(-0.5 * d, 1.25 * d), P::new(-0.5 * d, 0.25 * d));
+                // right arc bulges to −x (through angle π about its centre), left to +x (angle 0)
+                let (tr0, tr1) = (ang(cr, r0), ang(cr, r1));
+                let (tl0, tl1) = (ang(cl, l0), ang(cl, l1));
+                vec![
+                    Piece::Segment(P::new(-0.5 * d, 0.0), P::new(0.5 * d, 0.0)),
+                    Piece::Segment(P::new(0.5 * d, 0.0), r0),
+                    Piece::Arc(cr, r, tr0, tr1 - tr0 - 2.0 * PI),
+                    Piece::Segment(r1, P::new(0.5 * d, 1.5 * d)),
+                    Piece::Segment(P::new(0.5 * d, 1.5 * d), P::new(-0.5 * d, 1.5 * d)),
+                    Piece::Segment(P::new(-0.5 * d, 1.5 * d), l0),
+                    Piece::Arc(cl, r, tl0, tl1 - tl0),
+                    Piece::Segment(l1, P::new(-0.5 * d, 0.0)),
+                ]
+            }
+            _ => {
+                let v = self.polygon().expect("straight-edged shape");
+                (0..v.len())
+                    .map(|i| Piece::Segment(v[i], v[(i + 1) % v.len()]))
+                    .collect()
+            }
+        }
+    }
+
+    /// The outline as one polygon, counter-clockwise: the edges' corners, and the arcs in
+    /// chords of at most π/128 (a sagitta under 8e-5 of the radius; for drawing).
+    pub fn outline_polygon(&self) -> Vec<Vector2<f64>> {
+        let mut v = vec![];
+        for piece in self.outline() {
+            let parts = match piece {
+                Piece::Segment(..) => 1,
+                Piece::Arc(_, _, _, sweep) => {
+                    ((sweep.abs() / (std::f64::consts::PI / 128.0)).ceil() as usize).max(1)
+                }
+            };
+            v.extend((0..parts).map(|k| piece.at(k as f64 / parts as f64)));
+        }
+        v
+    }
+
     /// Whether `p` lies in the closed shape (boundary included within `tol`).
     pub fn contains(&self, p: &Vector2<f64>, tol: f64) -> bool {
         match self {
@@ -183,14 +227,66 @@ impl Shape2 {
     }
 }
 
+/// The two arcs that waist the dog-bone of size `d`: their radius 0.725·d and their centres
+/// (∓1.025·d, 0.75·d), left then right.
+pub fn dogbone_arcs(d: f64) -> (f64, [Vector2<f64>; 2]) {
+    (
+        0.725 * d,
+        [
+            Vector2::new(-1.025 * d, 0.75 * d),
+            Vector2::new(1.025 * d, 0.75 * d),
+        ],
+    )
+}
+
 /// Half-width of the dog-bone of size `d` at height `y` (0 ≤ y ≤ 1.5·d).
 pub fn dogbone_half_width(d: f64, y: f64) -> f64 {
-    let r = 0.725 * d;
-    let dy = y - 0.75 * d;
+    let (r, [_, c]) = dogbone_arcs(d);
+    let dy = y - c.y;
     if dy.abs() >= 0.5 * d {
         0.5 * d
     } else {
-        1.025 * d - (r * r - dy * dy).sqrt()
+        c.x - (r * r - dy * dy).sqrt()
+    }
+}
+
+/// Lower-left and upper-right corners of the box of a point set (infinite for no points).
+pub fn points_box<'a>(
+    points: impl IntoIterator<Item = &'a Vector2<f64>>,
+) -> (Vector2<f64>, Vector2<f64>) {
+    points.into_iter().fold(
+        (
+            Vector2::repeat(f64::INFINITY),
+            Vector2::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    )
+}
+
+/// One piece of a body's outline.
+pub enum Piece {
+    Segment(Vector2<f64>, Vector2<f64>),
+    /// Centre, radius, start angle, signed sweep (radians).
+    Arc(Vector2<f64>, f64, f64, f64),
+}
+
+impl Piece {
+    pub fn length(&self) -> f64 {
+        match self {
+            Piece::Segment(a, b) => (b - a).norm(),
+            Piece::Arc(_, r, _, sweep) => r * sweep.abs(),
+        }
+    }
+
+    /// The point at parameter t ∈ [0, 1] along the piece.
+    pub fn at(&self, t: f64) -> Vector2<f64> {
+        match self {
+            Piece::Segment(a, b) => a + (b - a) * t,
+            Piece::Arc(c, r, t0, sweep) => {
+                let th = t0 + sweep * t;
+                c + Vector2::new(th.cos(), th.sin()) * *r
+            }
+        }
     }
 }
 

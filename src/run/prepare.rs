@@ -73,7 +73,7 @@ pub fn estimated_particles(scene: &Scene) -> f64 {
 
 /// Estimated bytes a run allocates.
 pub fn estimated_memory(scene: &Scene) -> f64 {
-    estimated_particles(scene) * bytes_per_particle(2, 6) as f64
+    estimated_particles(scene) * bytes_per_particle(2, slots_of(scene)) as f64
 }
 
 /// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step), in
