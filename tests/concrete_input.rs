@@ -154,3 +154,26 @@ fn bad_material_input_is_refused() {
     let e = Scene::from_toml_str(&elastic, &[]).unwrap_err().to_string();
     assert!(e.contains("material.E") && e.contains("missing"), "{e}");
 }
+
+/// The crack band defaults by discretisation (lattices 2.8, random particles 3.2, both
+/// measured: benchmarks/RESULTS.md), is recorded with its source, and a scene's value wins.
+#[test]
+fn crack_band_defaults_by_discretisation() {
+    let band = |s: &Scene| s.concrete.as_ref().unwrap().crack_band.unwrap();
+    let lattice = scene(&[]).unwrap();
+    assert_eq!(band(&lattice), 2.8);
+    assert_eq!(lattice.derived_value("concrete.crack_band"), Some(2.8));
+    let random = scene(&["discretisation.lattice=\"random\""]).unwrap();
+    assert_eq!(band(&random), 3.2);
+    assert_eq!(random.derived_value("concrete.crack_band"), Some(3.2));
+    let given = scene(&[
+        "discretisation.lattice=\"random\"",
+        "concrete.crack_band=2.5",
+    ])
+    .unwrap();
+    assert_eq!(band(&given), 2.5);
+    assert!(given
+        .derived
+        .iter()
+        .any(|d| d.key == "concrete.crack_band" && d.source == "scene"));
+}

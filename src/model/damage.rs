@@ -73,7 +73,7 @@ impl ConcreteLaw {
             tensile_damage: c.tensile_damage,
             compressive_damage: c.compressive_damage,
             plasticity: c.plasticity,
-            crack_band: c.crack_band,
+            crack_band: c.crack_band.unwrap_or(f64::NAN),
         })
     }
 

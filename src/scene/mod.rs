@@ -305,12 +305,13 @@ pub struct ConcreteSpec {
     /// Largest compressive damage from (4.16); default 1.
     #[serde(default = "default_wc_max")]
     pub wc_max: f64,
-    /// The crack-band length of (4.13) in units of L0: COD_eq = crack_band·L0·ε_I. (4.13)
-    /// writes 2; the default 2.8 is measured: with 2, a block in uniaxial tension dissipates
-    /// 1.32 and 1.47 × G_f·A at L0 = 10 and 5 mm; with 2.8, 0.975 and 1.029 × G_f·A
-    /// (benchmarks/RESULTS.md, "Concrete in 2D").
-    #[serde(default = "default_crack_band")]
-    pub crack_band: f64,
+    /// The crack-band length of (4.13) in units of L0 (each particle's own length):
+    /// COD_eq = crack_band·L0·ε_I. (4.13) writes 2; the defaults are measured. Lattices 2.8:
+    /// with 2, a block in uniaxial tension dissipates 1.32 and 1.47 × G_f·A at L0 = 10 and
+    /// 5 mm; with 2.8, 0.975 and 1.029 × G_f·A (benchmarks/RESULTS.md, "Concrete in 2D").
+    /// Random particles 3.2 (docs/sppm.md, "Crack band"). Always set after [`Scene::resolve`].
+    #[serde(default)]
+    pub crack_band: Option<f64>,
     #[serde(default = "default_initiation")]
     pub initiation: Initiation,
     #[serde(default = "default_crack_opening")]
@@ -340,9 +341,6 @@ fn default_wt_cr() -> f64 {
 }
 fn default_wc_max() -> f64 {
     1.0
-}
-fn default_crack_band() -> f64 {
-    2.8
 }
 fn default_initiation() -> Initiation {
     Initiation::Rankine

@@ -6,6 +6,14 @@ use super::validate::invalid;
 use super::*;
 use crate::scene::concrete::{self as cc, Derived};
 
+/// The crack band of lattices in units of L0 (measured: benchmarks/RESULTS.md, "Concrete in
+/// 2D").
+pub const LATTICE_CRACK_BAND: f64 = 2.8;
+
+/// The crack band of random particles in units of each particle's mean bond length
+/// (measured: docs/sppm.md, "Crack band").
+pub const RANDOM_CRACK_BAND: f64 = 3.2;
+
 fn positive_opt(key: &str, v: Option<f64>) -> Result<(), SceneError> {
     match v {
         Some(x) if !(x.is_finite() && x > 0.0) => {
@@ -181,14 +189,31 @@ impl Scene {
         // The crack opening of a particle at initiation, 2·L0·f't/E (4.13): the softening law
         // needs room beyond it.
         let l0 = self.discretisation.spacing;
-        if !(c.crack_band.is_finite() && c.crack_band > 0.0 && c.crack_band <= 10.0) {
+        let random = self.discretisation.is_random();
+        let band = self.take("concrete.crack_band", c.crack_band, |_| {
+            Ok(if random {
+                (
+                    RANDOM_CRACK_BAND,
+                    "random particles' default (docs/sppm.md, \"Crack band\")".into(),
+                )
+            } else {
+                (
+                    LATTICE_CRACK_BAND,
+                    "lattices' default (benchmarks/RESULTS.md, \"Concrete in 2D\")".into(),
+                )
+            })
+        })?;
+        if !(band.is_finite() && band > 0.0 && band <= 10.0) {
             return Err(invalid(
                 "concrete.crack_band",
-                c.crack_band,
+                band,
                 "must satisfy 0 < crack_band <= 10 (a multiple of the lattice spacing)",
             ));
         }
-        let cod_el = c.crack_band * l0 * ft / e;
+        if let Some(cs) = self.concrete.as_mut() {
+            cs.crack_band = Some(band);
+        }
+        let cod_el = band * l0 * ft / e;
         if l0.is_finite() && l0 > 0.0 && cod_c <= cod_el {
             let gf_min = cod_el * ft * (c.alpha + c.gamma) / 2.0;
             return Err(invalid(
