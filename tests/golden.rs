@@ -89,7 +89,7 @@ const GOLDEN: &[Golden] = &[
     // criteria's neighbourhood mean (solver::concrete::Neighbourhood: peak 58.51 → 56.53 kN,
     // energy 1.771 → 1.911 J for this set; over 10 sets the energy fell), and when the scene
     // moved to L0 = 7 mm with the random particles' crack band 3.2 (was 10 mm and 2.8: over
-    // 100 runs the energy is 1.015 × G_f·A; docs/sppm.md, "Crack band").
+    // 200 runs the energy is 1.017 × G_f·A; docs/sppm.md, "Crack band").
     Golden {
         scene: "uniaxial_tension_random",
         peak_force_n: 60373.914544821375,

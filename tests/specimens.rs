@@ -3,6 +3,8 @@
 //! reaches the engineering peak and cracks across its narrow section; both, symmetric with a
 //! symmetric lattice, crack symmetrically.
 
+mod common;
+
 use sppm::run::{run, Outcome, RunOptions};
 use sppm::Scene;
 use std::collections::HashMap;
@@ -37,9 +39,8 @@ fn split_cylinder_peak_crack_and_symmetry() {
     assert_eq!(s.status, "completed");
     // (5.6) with β = b/D = 25/150
     let (d, h, b) = (0.15, 0.30, 0.025);
-    let beta: f64 = b / d;
     let ft = scene.derived_value("ft").unwrap();
-    let p56 = std::f64::consts::FRAC_PI_2 * ft * d * h / (1.0 - beta * beta).powf(1.5);
+    let p56 = common::split_cylinder_peak(ft, d, h, b);
     println!(
         "peak {:.1} kN against (5.6) {:.1} kN: {:+.2}%",
         s.peak_force_n / 1e3,

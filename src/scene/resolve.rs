@@ -189,19 +189,19 @@ impl Scene {
         // The crack opening of a particle at initiation, 2·L0·f't/E (4.13): the softening law
         // needs room beyond it.
         let l0 = self.discretisation.spacing;
-        let random = self.discretisation.is_random();
+        let (default, source) = if self.discretisation.is_random() {
+            (
+                RANDOM_CRACK_BAND,
+                "random particles' default (docs/sppm.md, \"Crack band\")",
+            )
+        } else {
+            (
+                LATTICE_CRACK_BAND,
+                "lattices' default (benchmarks/RESULTS.md, \"Concrete in 2D\")",
+            )
+        };
         let band = self.take("concrete.crack_band", c.crack_band, |_| {
-            Ok(if random {
-                (
-                    RANDOM_CRACK_BAND,
-                    "random particles' default (docs/sppm.md, \"Crack band\")".into(),
-                )
-            } else {
-                (
-                    LATTICE_CRACK_BAND,
-                    "lattices' default (benchmarks/RESULTS.md, \"Concrete in 2D\")".into(),
-                )
-            })
+            Ok((default, source.into()))
         })?;
         if !(band.is_finite() && band > 0.0 && band <= 10.0) {
             return Err(invalid(

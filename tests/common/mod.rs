@@ -295,3 +295,11 @@ pub fn wait_until(limit: std::time::Duration, what: &str, ready: impl Fn() -> bo
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
 }
+
+/// The split cylinder's reference peak (5.6) (Rocco et al., VALIDATION.md §C):
+/// P = (π/2)·f't·D·H / (1 − β²)^1.5 with β = b/D, for diameter `d`, length `h` and strip
+/// width `b`.
+pub fn split_cylinder_peak(ft: f64, d: f64, h: f64, b: f64) -> f64 {
+    let beta = b / d;
+    std::f64::consts::FRAC_PI_2 * ft * d * h / (1.0 - beta * beta).powf(1.5)
+}
