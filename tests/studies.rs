@@ -470,4 +470,24 @@ fn objectivity_on_random_particles_turns_the_same_sets() {
         assert!(a["cov_peak_force"].as_f64().unwrap() >= 0.0);
         assert!(a["cov_dissipated_energy"].as_f64().unwrap() >= 0.0);
     }
+    // the angle effect of the peak: the spread of the two angles' means over the mean of
+    // all four runs; with two runs per angle only the observed split of the four values and
+    // its mirror image reach that spread at most, so p ≥ 2/6 less the shuffles' scatter
+    let m = |a: &str| 0.5 * (peak(a, "0") + peak(a, "1"));
+    let all = 0.5 * (m("0") + m("30"));
+    let effect = &report["peak_force_angle_effect"];
+    let spread = effect["spread_of_means"].as_f64().unwrap();
+    assert!(
+        (spread - (m("0") - m("30")).abs() / all).abs() < 1e-12 * spread.max(1e-300),
+        "{effect}"
+    );
+    let p = effect["p_value"].as_f64().unwrap();
+    assert!(p > 0.3 && p <= 1.0, "{effect}");
+    assert_eq!(effect["permutations"], 10_000);
+    assert!(
+        report["dissipated_energy_angle_effect"]["p_value"]
+            .as_f64()
+            .unwrap()
+            > 0.3
+    );
 }

@@ -139,6 +139,9 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 progress: !quiet,
             })?;
             crate::say!("{}", report.spread_line());
+            if let Some(line) = report.angle_effect_line() {
+                crate::say!("{line}");
+            }
             if !quiet {
                 crate::say!("wrote {}", report.dir.display());
             }

@@ -4,7 +4,8 @@
 //! - [`runner`]: the generic parallel runner of scene variants and its CSV.
 //! - [`objectivity`]: lattice rotations and offsets (peak-force spread, crack path).
 //! - [`convergence`]: lattice spacings (Richardson reference and observed order).
-//! - [`crack_path`], [`extrapolation`]: the pure functions the studies report with.
+//! - [`crack_path`], [`extrapolation`]: the pure functions the studies report with;
+//!   [`angle_effect`]: whether per-angle means differ by more than their realisations' scatter.
 //! - [`plots`]: the overlay, convergence and size-effect plots; [`cli`]: the `sppm study`
 //!   command.
 //! - [`monte_carlo`]: realisations of the random fields per specimen size, shards and their
@@ -12,6 +13,7 @@
 //!   [`size_effect_report`]: the size-effect table, JSON and plot.
 //! - [`pareto`]: run time against error (`benchmarks/pareto.rs`).
 
+pub mod angle_effect;
 pub mod cli;
 pub mod convergence;
 pub mod crack_path;

@@ -11,8 +11,11 @@
 //! On random particles (SPPM) "offset" k is realisation k: the particle set of seed
 //! [`realisation_seed`] (k = 0: the scene's own), turned by each angle against the body
 //! (`discretise::random`). objectivity.json reports, per angle, the mean and the coefficient
-//! of variation of the peak force and the energy over the realisations.
+//! of variation of the peak force and the energy over the realisations, and for each the
+//! spread of the per-angle means against what the realisations' scatter alone gives
+//! ([`angle_effect`](super::angle_effect): a permutation test's p-value).
 
+use super::angle_effect::{angle_effect, AngleEffect};
 use super::crack_path::{crack_core, crack_path, mean_axis_deg};
 use super::runner::{RunResult, Study, Variant};
 use crate::random_field::splitmix64;
@@ -203,11 +206,34 @@ pub struct ObjectivityReport {
     pub peak_force: Option<Spread>,
     pub dissipated_energy: Option<Spread>,
     pub per_angle: Vec<AngleSummary>,
+    /// Whether the per-angle means of the peak force and of the energy differ by more than
+    /// the scatter of the runs at each angle gives (`None` with fewer than two angles of two
+    /// completed runs).
+    pub peak_force_angle_effect: Option<AngleEffect>,
+    pub dissipated_energy_angle_effect: Option<AngleEffect>,
     pub rows: Vec<super::runner::RunRow>,
     pub dir: PathBuf,
 }
 
 impl ObjectivityReport {
+    /// The per-angle means' spreads against the realisations' scatter, one line (where the
+    /// study has at least two angles of two completed runs).
+    pub fn angle_effect_line(&self) -> Option<String> {
+        let (p, e) = (
+            self.peak_force_angle_effect.as_ref()?,
+            self.dissipated_energy_angle_effect.as_ref()?,
+        );
+        Some(format!(
+            "per-angle means spread: peak force {:.2}% (from the scatter alone {:.2}%, p = {:.3}), energy {:.2}% ({:.2}%, p = {:.3})",
+            100.0 * p.spread_of_means,
+            100.0 * p.expected_spread_without_angle_effect,
+            p.p_value,
+            100.0 * e.spread_of_means,
+            100.0 * e.expected_spread_without_angle_effect,
+            e.p_value
+        ))
+    }
+
     /// The one line the CLI prints.
     pub fn spread_line(&self) -> String {
         match &self.peak_force {
@@ -412,6 +438,22 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
             }
         })
         .collect();
+    let groups = |value: &dyn Fn(&RunResult) -> f64| -> Vec<Vec<f64>> {
+        args.angles_deg
+            .iter()
+            .map(|&a| {
+                results
+                    .iter()
+                    .filter(|r| r.row.completed() && r.row.rotation_deg == a)
+                    .map(value)
+                    .filter(|v| v.is_finite())
+                    .collect()
+            })
+            .collect()
+    };
+    let peak_force_angle_effect = angle_effect(&groups(&|r| r.row.peak_force_n), args.seed);
+    let dissipated_energy_angle_effect =
+        angle_effect(&groups(&|r| r.row.dissipated_energy_j), args.seed);
     let report = ObjectivityReport {
         scene: base.name().to_string(),
         scene_file: args.scene.display().to_string(),
@@ -425,6 +467,8 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         peak_force: spread(&results, |r| r.row.peak_force_n),
         dissipated_energy: spread(&results, |r| r.row.dissipated_energy_j),
         per_angle,
+        peak_force_angle_effect,
+        dissipated_energy_angle_effect,
         rows: results.iter().map(|r| r.row.clone()).collect(),
         dir: dir.clone(),
     };
