@@ -36,18 +36,16 @@ pub struct AngleEffect {
     pub permutations: usize,
 }
 
-/// (max − min)/mean of the means of `groups` (the mean of all values in the denominator).
-fn spread_of_means(values: &[f64], sizes: &[usize]) -> f64 {
-    let mut means = Vec::with_capacity(sizes.len());
-    let mut start = 0;
+/// (max − min)/`mean` of the means of the consecutive groups of `sizes` in `values` (`mean`:
+/// the mean of all values, which no assignment changes).
+fn spread_of_means(values: &[f64], sizes: &[usize], mean: f64) -> f64 {
+    let (mut hi, mut lo, mut start) = (f64::MIN, f64::MAX, 0);
     for &n in sizes {
-        means.push(values[start..start + n].iter().sum::<f64>() / n as f64);
+        let m = values[start..start + n].iter().sum::<f64>() / n as f64;
+        (hi, lo) = (hi.max(m), lo.min(m));
         start += n;
     }
-    let all = values.iter().sum::<f64>() / values.len() as f64;
-    let hi = means.iter().cloned().fold(f64::MIN, f64::max);
-    let lo = means.iter().cloned().fold(f64::MAX, f64::min);
-    (hi - lo) / all
+    (hi - lo) / mean
 }
 
 /// The angle effect of `groups` (one group of finite values per angle), from `seed`;
@@ -61,7 +59,8 @@ pub fn angle_effect(groups: &[Vec<f64>], seed: u64) -> Option<AngleEffect> {
     if values.iter().any(|v| !v.is_finite()) || values.iter().sum::<f64>() == 0.0 {
         return None;
     }
-    let observed = spread_of_means(&values, &sizes);
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let observed = spread_of_means(&values, &sizes, mean);
     let mut rng = ChaCha20Rng::seed_from_u64(seed);
     let (mut at_least, mut sum) = (0usize, 0.0);
     for _ in 0..PERMUTATIONS {
@@ -70,7 +69,7 @@ pub fn angle_effect(groups: &[Vec<f64>], seed: u64) -> Option<AngleEffect> {
             let j = rng.random_range(0..=i);
             values.swap(i, j);
         }
-        let s = spread_of_means(&values, &sizes);
+        let s = spread_of_means(&values, &sizes, mean);
         sum += s;
         // a relative tolerance, so that an assignment equal to the observed one counts
         if s >= observed * (1.0 - 1e-12) {

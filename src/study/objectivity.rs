@@ -399,61 +399,63 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
         (v.len() >= 2).then(|| super::size_effect::sample(&v).cov)
     };
-    let per_angle = args
+    // the completed runs of each angle, in the order of `angles_deg`
+    let by_angle: Vec<Vec<&RunResult>> = args
         .angles_deg
         .iter()
         .map(|&a| {
-            let rs: Vec<&RunResult> = results
+            results
                 .iter()
                 .filter(|r| r.row.completed() && r.row.rotation_deg == a)
-                .collect();
-            AngleSummary {
-                angle_deg: a,
-                runs: rs.len(),
-                mean_peak_force_n: mean_of(rs.iter().map(|r| r.row.peak_force_n).collect())
-                    .unwrap_or(f64::NAN),
-                mean_dissipated_energy_j: mean_of(
-                    rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
-                )
-                .unwrap_or(f64::NAN),
-                cov_peak_force: cov_of(rs.iter().map(|r| r.row.peak_force_n).collect()),
-                cov_dissipated_energy: cov_of(
-                    rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
-                ),
-                mean_crack_axis_deg: mean_axis_deg(
-                    &rs.iter()
-                        .map(|r| metric(r, "crack_axis_deg"))
-                        .filter(|a| a.is_finite())
-                        .collect::<Vec<_>>(),
-                ),
-                mean_crack_centroid_x_m: mean_of(
-                    rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
-                ),
-                mean_crack_core_axis_deg: mean_axis_deg(
-                    &rs.iter()
-                        .map(|r| metric(r, "crack_core_axis_deg"))
-                        .filter(|a| a.is_finite())
-                        .collect::<Vec<_>>(),
-                ),
-            }
+                .collect()
         })
         .collect();
-    let groups = |value: &dyn Fn(&RunResult) -> f64| -> Vec<Vec<f64>> {
-        args.angles_deg
+    let per_angle = args
+        .angles_deg
+        .iter()
+        .zip(&by_angle)
+        .map(|(&a, rs)| AngleSummary {
+            angle_deg: a,
+            runs: rs.len(),
+            mean_peak_force_n: mean_of(rs.iter().map(|r| r.row.peak_force_n).collect())
+                .unwrap_or(f64::NAN),
+            mean_dissipated_energy_j: mean_of(
+                rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
+            )
+            .unwrap_or(f64::NAN),
+            cov_peak_force: cov_of(rs.iter().map(|r| r.row.peak_force_n).collect()),
+            cov_dissipated_energy: cov_of(rs.iter().map(|r| r.row.dissipated_energy_j).collect()),
+            mean_crack_axis_deg: mean_axis_deg(
+                &rs.iter()
+                    .map(|r| metric(r, "crack_axis_deg"))
+                    .filter(|a| a.is_finite())
+                    .collect::<Vec<_>>(),
+            ),
+            mean_crack_centroid_x_m: mean_of(
+                rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
+            ),
+            mean_crack_core_axis_deg: mean_axis_deg(
+                &rs.iter()
+                    .map(|r| metric(r, "crack_core_axis_deg"))
+                    .filter(|a| a.is_finite())
+                    .collect::<Vec<_>>(),
+            ),
+        })
+        .collect();
+    let groups = |value: fn(&RunResult) -> f64| -> Vec<Vec<f64>> {
+        by_angle
             .iter()
-            .map(|&a| {
-                results
-                    .iter()
-                    .filter(|r| r.row.completed() && r.row.rotation_deg == a)
-                    .map(value)
+            .map(|rs| {
+                rs.iter()
+                    .map(|r| value(r))
                     .filter(|v| v.is_finite())
                     .collect()
             })
             .collect()
     };
-    let peak_force_angle_effect = angle_effect(&groups(&|r| r.row.peak_force_n), args.seed);
+    let peak_force_angle_effect = angle_effect(&groups(|r| r.row.peak_force_n), args.seed);
     let dissipated_energy_angle_effect =
-        angle_effect(&groups(&|r| r.row.dissipated_energy_j), args.seed);
+        angle_effect(&groups(|r| r.row.dissipated_energy_j), args.seed);
     let report = ObjectivityReport {
         scene: base.name().to_string(),
         scene_file: args.scene.display().to_string(),
