@@ -24,6 +24,9 @@
 //!    [`Kernel::Full`] law) from its bonds' stretches ([`ParticleBonds`]: total, elastic,
 //!    damaged, the strain fit, its micro-modulus and length scale).
 //! 5. [`DamageLaw::view`]: the state as the outputs show it ([`ParticleDamage`]).
+//! 6. Optionally [`DamageLaw::SERIES_DAMAGE`] and [`DamageLaw::series_damage`], if its bond
+//!    factor is the two springs in series (3.37) of two damage variables per particle: pass 1
+//!    then runs four particles at once (SIMD).
 //!
 //! Then `run` builds `solver::concrete::Concrete::<K, YourLaw>::new(law, &body)` where it
 //! builds the two-spring law today.
@@ -124,6 +127,20 @@ where
         j: &Self::State,
         elastic_stretch: f64,
     ) -> (f64, f64);
+
+    /// Whether [`DamageLaw::bond_factor`] is the two springs in series (3.37) of the damage
+    /// variables [`DamageLaw::series_damage`] gives: with w = w_t of both particles where
+    /// S_e ≥ 0, w_c where S_e < 0 and `FULL` (0 otherwise), (1, 1) when both w are 0, and
+    /// `model::damage::damage_factor` and its square root otherwise. A law that says so gets
+    /// the kernel's SIMD pass 1, which evaluates that rule four bonds at once, bit for bit as
+    /// `bond_factor` would (`solver::concrete` tests it); the default, `false`, runs the scalar
+    /// pass through `bond_factor`.
+    const SERIES_DAMAGE: bool = false;
+
+    /// (w_t, w_c) of a particle in `state`, read only where [`DamageLaw::SERIES_DAMAGE`].
+    fn series_damage(&self, _state: &Self::State) -> (f64, f64) {
+        (0.0, 0.0)
+    }
 
     /// Update `state` (the committed state on entry, the trial state on exit) and, with
     /// `FULL`, the plastic stretch states `sps` (committed on entry) of particle `bonds.i`.

@@ -86,6 +86,13 @@ where
         }
     }
 
+    const SERIES_DAMAGE: bool = true;
+
+    #[inline(always)]
+    fn series_damage(&self, p: &ParticleDamage) -> (f64, f64) {
+        (p.wt, p.wc)
+    }
+
     /// Tensile initiation and damage (§8), compressive damage and plastic flow (§9).
     /// `FULL = false` (the tension kernel) evaluates neither ε_eff, compressive damage nor the
     /// yield criterion; on a law without them it gives the same numbers as `FULL = true`.

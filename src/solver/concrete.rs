@@ -1,4 +1,4 @@
-//! The step kernel with two-spring damage and plasticity (MODEL.md §2, §6–9), for 2D lattices.
+//! The step kernel with two-spring damage and plasticity (MODEL.md §2, §6–9) on the slot layout.
 //!
 //! Same shape as the elastic kernel (`kernel.rs`): two gather passes, parallel over particles,
 //! no scatter and no allocation, so results do not depend on the thread count. State variables
@@ -10,6 +10,9 @@
 //! 1. Each particle, from its slots: elastic stretch S_e = S_T − ½(S_Ps,ij + S_Ps,ji) (3.38),
 //!    damage factor d (3.37), bθ_i = b_i·Σ_m √d_im·S_e,im; then strain, criteria stress,
 //!    damage and plastic flow → trial state.
+//!    Where the law's bond factor is the two springs in series ([`DamageLaw::SERIES_DAMAGE`])
+//!    and the CPU has AVX, the slot loop runs four particles at a time (`avx::slot_block`,
+//!    bit-identical to `slot_pass`; `tests::pass_state_simd_matches_scalar_bitwise`).
 //! 2. Each particle gathers F_b,ij = ½(d_ij·(a_i + a_j)·S_e,ij + √d_ij·(bθ_i + bθ_j)) along
 //!    e_ij, with the bond damper scaled by d_ij, and integrates.
 //!
@@ -31,7 +34,7 @@
 //! (`model::two_spring`) is one implementation. This kernel computes the kinematics, asks the
 //! law for each bond's damage factor and each particle's new state, and moves the particles.
 
-use super::kernel::central_difference;
+use super::kernel::{central_difference, chunk_len, use_avx, LANES};
 use super::mechanics::{weighted, Mechanics};
 use super::KernelSet;
 use crate::discretise::{Particles, NONE};
@@ -46,6 +49,9 @@ use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
+
+#[cfg(target_arch = "x86_64")]
+mod avx;
 
 /// Damage and plasticity of a run: the law, the per-particle geometry the kernel needs, and
 /// the committed and trial state.
@@ -74,6 +80,9 @@ where
     /// Criteria strain averaged over each particle's neighbourhood (random particles), see
     /// [`Neighbourhood`]; `None`: each particle's own.
     pub neighbourhood: Option<Neighbourhood<D>>,
+    /// Let pass 1 run its SIMD blocks where it can (`true`; `false` for tests that compare
+    /// them with the scalar path).
+    pub simd: bool,
 }
 
 /// The criteria (initiation, yield) of a particle read the volume-weighted mean of the damaged
@@ -158,6 +167,7 @@ where
             cache: vec![[SlotCache::default(); K]; n],
             force_full: false,
             neighbourhood: None,
+            simd: true,
         }
     }
 
@@ -295,6 +305,128 @@ where
     (out, dilatation_term(m.b[i], theta))
 }
 
+/// Particle i's stretches slot by slot (0 and `used = false` in empty slots), as pass 1 hands
+/// them to the law: total, elastic, damaged elastic, and the two dilatation sums.
+#[derive(Clone, Copy)]
+pub(super) struct Stretches<const K: usize> {
+    st: [f64; K],
+    se: [f64; K],
+    dse: [f64; K],
+    used: [bool; K],
+    /// Σ_m w_im·√d_im·S_e,im.
+    theta: f64,
+    /// Σ_m w_im·S_e,im.
+    theta_e: f64,
+    /// The damaged elastic stretches equal the total ones (undamaged bonds, no plastic
+    /// stretch): one strain fit serves both.
+    same: bool,
+}
+
+impl<const K: usize> Default for Stretches<K> {
+    fn default() -> Self {
+        Stretches {
+            st: [0.0; K],
+            se: [0.0; K],
+            dse: [0.0; K],
+            used: [false; K],
+            theta: 0.0,
+            theta_e: 0.0,
+            same: true,
+        }
+    }
+}
+
+/// Pass 1's slot loop for particle i: its [`Stretches`] and the slot cache for pass 2
+/// (the scalar path; `avx::slot_block` does four particles at once, bit for bit the same).
+#[inline(always)]
+fn slot_pass<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
+    i: usize,
+    cache: &mut [SlotCache<D>; K],
+) -> Stretches<K>
+where
+    Dim<D>: Dimension<D>,
+{
+    let mut s = Stretches::<K>::default();
+    let w = m.weights(i);
+    for (k, ca) in cache.iter_mut().enumerate() {
+        *ca = match slot::<D, K, L, FULL>(m, c, x, i, k) {
+            Some(b) => {
+                let j = m.neighbours[i][k] as usize;
+                s.st[k] = b.st;
+                s.se[k] = b.se;
+                s.dse[k] = b.d * b.se;
+                s.used[k] = true;
+                s.theta += weighted(w, k, b.sd * b.se);
+                s.theta_e += weighted(w, k, b.se);
+                s.same &= s.dse[k] == s.st[k];
+                SlotCache {
+                    e: b.e,
+                    d_a_se: damaged_axial(b.d, m.a[i], m.a[j], b.se),
+                    sd: b.sd,
+                    d: b.d,
+                }
+            }
+            None => SlotCache::default(),
+        };
+    }
+    s
+}
+
+/// Pass 1's law update for particle i from its [`Stretches`]: the trial law state and
+/// plastic stretch state (from the law, [`DamageLaw::update`]) and, for the neighbourhood
+/// criteria, its own strain; returns bθ_i.
+#[inline(always)]
+fn law_pass<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    i: usize,
+    s: &Stretches<K>,
+    trial: &mut L::State,
+    sps_trial: &mut [f64; K],
+    own_strain: Option<&mut Tensor<D>>,
+) -> f64
+where
+    Dim<D>: Dimension<D>,
+{
+    let mut state = c.committed[i];
+    if FULL {
+        *sps_trial = c.sps[i];
+    }
+    // the neighbourhood's mean criteria strain (previous step) and this particle's own (trial)
+    let mean_strain = match (&c.neighbourhood, own_strain) {
+        (Some(nb), Some(own)) => {
+            *own = if s.same {
+                Dim::<D>::strain_tensor(&c.fit[i], &s.st)
+            } else {
+                Dim::<D>::strain_tensor(&c.fit[i], &s.dse)
+            };
+            Some(nb.mean(i, &m.neighbours[i], |j| {
+                c.law.view(&c.committed[j]).wt > 0.0
+            }))
+        }
+        _ => None,
+    };
+    let bonds = ParticleBonds {
+        i,
+        fit: &c.fit[i],
+        total: &s.st,
+        elastic: &s.se,
+        damaged: &s.dse,
+        used: &s.used,
+        undamaged: s.same,
+        a: m.a[i],
+        b_theta_elastic: dilatation_term(m.b[i], s.theta_e),
+        lengths: &c.length,
+        criteria_strain: mean_strain.as_ref(),
+    };
+    c.law.update::<FULL>(&bonds, &mut state, sps_trial);
+    *trial = state;
+    dilatation_term(m.b[i], s.theta)
+}
+
 /// Pass 1 for particle i: bθ_i, the slot cache for pass 2, and the trial law state and
 /// plastic stretch state (from the law, [`DamageLaw::update`]).
 ///
@@ -315,75 +447,89 @@ fn update_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: 
 where
     Dim<D>: Dimension<D>,
 {
-    // One pass over the slots: the cache for pass 2, bθ_i, and the stretches for the strain.
-    let mut st = [0.0; K];
-    let mut se = [0.0; K];
-    let mut dse = [0.0; K];
-    let mut used = [false; K];
-    let mut theta = 0.0;
-    let mut theta_e = 0.0;
-    // The damaged elastic stretches equal the total ones (undamaged bonds, no plastic
-    // stretch): one strain fit serves both.
-    let mut same = true;
-    let w = m.weights(i);
-    for k in 0..K {
-        cache[k] = match slot::<D, K, L, FULL>(m, c, x, i, k) {
-            Some(s) => {
-                let j = m.neighbours[i][k] as usize;
-                st[k] = s.st;
-                se[k] = s.se;
-                dse[k] = s.d * s.se;
-                used[k] = true;
-                theta += weighted(w, k, s.sd * s.se);
-                theta_e += weighted(w, k, s.se);
-                same &= dse[k] == st[k];
-                SlotCache {
-                    e: s.e,
-                    d_a_se: damaged_axial(s.d, m.a[i], m.a[j], s.se),
-                    sd: s.sd,
-                    d: s.d,
-                }
-            }
-            None => SlotCache::default(),
-        };
-    }
-    let mut state = c.committed[i];
-    if FULL {
-        *sps_trial = c.sps[i];
-    }
-    // the neighbourhood's mean criteria strain (previous step) and this particle's own (trial)
-    let mean_strain = match (&c.neighbourhood, own_strain) {
-        (Some(nb), Some(own)) => {
-            *own = if same {
-                Dim::<D>::strain_tensor(&c.fit[i], &st)
-            } else {
-                Dim::<D>::strain_tensor(&c.fit[i], &dse)
-            };
-            Some(nb.mean(i, &m.neighbours[i], |j| {
-                c.law.view(&c.committed[j]).wt > 0.0
-            }))
-        }
-        _ => None,
-    };
-    let bonds = ParticleBonds {
-        i,
-        fit: &c.fit[i],
-        total: &st,
-        elastic: &se,
-        damaged: &dse,
-        used: &used,
-        undamaged: same,
-        a: m.a[i],
-        b_theta_elastic: dilatation_term(m.b[i], theta_e),
-        lengths: &c.length,
-        criteria_strain: mean_strain.as_ref(),
-    };
-    c.law.update::<FULL>(&bonds, &mut state, sps_trial);
-    *trial = state;
-    dilatation_term(m.b[i], theta)
+    let s = slot_pass::<D, K, L, FULL>(m, c, x, i, cache);
+    law_pass::<D, K, L, FULL>(m, c, i, &s, trial, sps_trial, own_strain)
 }
 
-/// Pass 1 over all particles.
+/// Pass 1 over one chunk of particles from `base` on (every slice holds the chunk's
+/// particles): with `avx`, whole blocks of four through `avx::slot_block` and the rest one by
+/// one, bit for bit the same.
+// The arguments are the chunk's inputs and its disjoint outputs.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn state_chunk<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
+    base: usize,
+    b_theta: &mut [f64],
+    trial: &mut [L::State],
+    sps_trial: &mut [[f64; K]],
+    cache: &mut [[SlotCache<D>; K]],
+    mut own: Option<&mut [Tensor<D>]>,
+    avx: bool,
+) where
+    Dim<D>: Dimension<D>,
+{
+    let n = b_theta.len();
+    assert!(base + n <= m.len() && m.len() == x.len());
+    assert!(trial.len() == n && sps_trial.len() == n && cache.len() == n);
+    assert!(own.as_ref().is_none_or(|o| o.len() == n));
+    #[cfg(target_arch = "x86_64")]
+    let done = if avx {
+        let done = n / LANES * LANES;
+        let mut s = [Stretches::<K>::default(); LANES];
+        for o in (0..done).step_by(LANES) {
+            // SAFETY: AVX is available (`use_avx`, checked by the caller); base + o + 4 ≤
+            // m.len() = x.len() and cache[o..o + 4] exists (asserted above); Mechanics::new
+            // checks every occupied slot indexes a particle.
+            let ca = &mut cache[o..o + LANES];
+            unsafe {
+                if m.dilatation_weight.is_some() {
+                    avx::slot_block::<D, K, L, FULL, true>(m, c, x, base + o, ca, &mut s)
+                } else {
+                    avx::slot_block::<D, K, L, FULL, false>(m, c, x, base + o, ca, &mut s)
+                }
+            };
+            for (l, s) in s.iter().enumerate() {
+                let p = o + l;
+                b_theta[p] = law_pass::<D, K, L, FULL>(
+                    m,
+                    c,
+                    base + p,
+                    s,
+                    &mut trial[p],
+                    &mut sps_trial[p],
+                    own.as_deref_mut().map(|own| &mut own[p]),
+                );
+            }
+        }
+        done
+    } else {
+        0
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = {
+        let _ = avx;
+        0
+    };
+    for p in done..n {
+        b_theta[p] = update_state::<D, K, L, FULL>(
+            m,
+            c,
+            x,
+            base + p,
+            &mut trial[p],
+            &mut sps_trial[p],
+            &mut cache[p],
+            own.as_deref_mut().map(|own| &mut own[p]),
+        );
+    }
+}
+
+/// Pass 1 over all particles, in chunks of [`chunk_len`] (a multiple of the SIMD width); the
+/// SIMD blocks run where the law's bond factor is the series one
+/// ([`DamageLaw::SERIES_DAMAGE`]) and the CPU has AVX.
 fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
     m: &Mechanics<D, K>,
     c: &mut Concrete<D, K, L>,
@@ -392,6 +538,7 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
 ) where
     Dim<D>: Dimension<D>,
 {
+    let avx = L::SERIES_DAMAGE && c.simd && use_avx();
     let mut trial = std::mem::take(&mut c.trial);
     let mut sps_trial = std::mem::take(&mut c.sps_trial);
     let mut cache = std::mem::take(&mut c.cache);
@@ -401,25 +548,33 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
         .map(|nb| std::mem::take(&mut nb.strain_trial));
     {
         let c = &*c;
+        let chunk = chunk_len(b_theta.len());
         let zipped = b_theta
-            .par_iter_mut()
-            .zip(trial.par_iter_mut())
-            .zip(sps_trial.par_iter_mut())
-            .zip(cache.par_iter_mut());
+            .par_chunks_mut(chunk)
+            .zip(trial.par_chunks_mut(chunk))
+            .zip(sps_trial.par_chunks_mut(chunk))
+            .zip(cache.par_chunks_mut(chunk))
+            .enumerate();
         match &mut strain_trial {
-            Some(own) => zipped
-                .zip(own.par_iter_mut())
-                .enumerate()
-                .with_min_len(256)
-                .for_each(|(i, ((((bt, tr), sp), ca), own))| {
-                    *bt = update_state::<D, K, L, FULL>(m, c, x, i, tr, sp, ca, Some(own))
-                }),
-            None => zipped
-                .enumerate()
-                .with_min_len(256)
-                .for_each(|(i, (((bt, tr), sp), ca))| {
-                    *bt = update_state::<D, K, L, FULL>(m, c, x, i, tr, sp, ca, None)
-                }),
+            Some(own) => zipped.zip(own.par_chunks_mut(chunk)).for_each(
+                |((ci, (((bt, tr), sp), ca)), own)| {
+                    state_chunk::<D, K, L, FULL>(
+                        m,
+                        c,
+                        x,
+                        ci * chunk,
+                        bt,
+                        tr,
+                        sp,
+                        ca,
+                        Some(own),
+                        avx,
+                    )
+                },
+            ),
+            None => zipped.for_each(|(ci, (((bt, tr), sp), ca))| {
+                state_chunk::<D, K, L, FULL>(m, c, x, ci * chunk, bt, tr, sp, ca, None, avx)
+            }),
         }
     }
     if let (Some(nb), Some(s)) = (c.neighbourhood.as_mut(), strain_trial) {
@@ -692,7 +847,266 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Matrix2;
+    use crate::discretise::hex::HexLattice;
+    use crate::discretise::random::{self, RandomParticles};
+    use crate::geometry::Shape2;
+    use crate::model::damage::ConcreteLaw;
+    use crate::solver::test_rng::Lcg;
+    use nalgebra::{Matrix2, Vector2};
+
+    /// The bench's concrete law, with or without the compressive branch and plasticity.
+    fn law(full: bool) -> TwoSpring<2> {
+        let cod_c = crate::scene::concrete::critical_crack_opening(81.4, 2.6168e6, 0.1, 0.25);
+        TwoSpring::new(
+            ConcreteLaw {
+                e: 30e9,
+                nu: 0.2,
+                plane: crate::scene::Plane::Stress,
+                fc: 27.58e6,
+                ft: 2.6168e6,
+                fy: 22.983e6,
+                fult: 27.58e6,
+                gf: 81.4,
+                cod_c,
+                cod_1: 0.1 * cod_c,
+                gamma: 0.25,
+                eps_ult: 0.0035,
+                wt_cr: 1.0 / 3.0,
+                wc_max: 1.0,
+                initiation: crate::scene::Initiation::Rankine,
+                crack_opening: crate::scene::CrackOpening::Total,
+                tensile_damage: true,
+                compressive_damage: full,
+                plasticity: full,
+                crack_band: 2.8,
+            },
+            None,
+        )
+    }
+
+    /// A block strained by up to ±2·f't/E per bond, with every kind of committed state:
+    /// intact, initiated, partly damaged in tension and compression, fully damaged (w = 1,
+    /// where the series factor is 0/0), plastic stretch in every bond.
+    fn damaged<const K: usize>(
+        p: &Particles<2, K>,
+        full: bool,
+        seed: u64,
+    ) -> (Mechanics<2, K>, Concrete<2, K>, Vec<Vector2<f64>>) {
+        let n = p.len();
+        let mut r = Lcg(seed);
+        let mut m = Mechanics::new(p, &vec![2400.0; n]);
+        for i in 0..n {
+            m.a[i] = 3e6 * (1.0 + 0.1 * r.next());
+            m.b[i] = -1e6 * (1.0 + 0.1 * r.next());
+            m.c_in[i] = 5.0 * (1.0 + r.next());
+            m.c_ex[i] = if i % 3 == 0 { 0.0 } else { 2.0 * r.next() };
+        }
+        let mut c = Concrete::new(law(full), p);
+        let mut w = || match (r.next() * 10.0) as u32 {
+            0..=4 => 0.0,
+            5..=7 => r.next(),
+            8 => 1.0,
+            _ => 1.0 + r.next(),
+        };
+        for s in c.committed.iter_mut() {
+            s.wt = w();
+            s.wc = if full { w() } else { 0.0 };
+            s.initiated = s.wt > 0.0;
+            s.eps_init = 8e-5;
+        }
+        let mut r = Lcg(seed + 1);
+        for (i, s) in c.sps.iter_mut().enumerate() {
+            for (k, s) in s.iter_mut().enumerate() {
+                if full && p.neighbours[i][k] != NONE {
+                    *s = 2e-4 * (r.next() - 0.5);
+                }
+            }
+        }
+        let eps = 2.0 * 2.6168e6 / 30e9;
+        let x = p
+            .x0
+            .iter()
+            .map(|x0| x0 + Vector2::new(r.next() - 0.3, r.next() - 0.5) * eps * 40.0 * p.spacing)
+            .map(|x| x * (1.0 + 0.5 * eps))
+            .collect();
+        (m, c, x)
+    }
+
+    /// Pass 1 through the SIMD blocks and through the scalar chunks, on 1 and 2 threads,
+    /// against `update_state` particle by particle: the same bits in bθ, the trial state, the
+    /// plastic stretch states, the slot cache and the neighbourhood's strains.
+    fn check_pass_state<const K: usize, const FULL: bool>(p: &Particles<2, K>, nb: bool) {
+        let (m, mut c, x) = damaged(p, FULL, 99);
+        if nb {
+            c = c.with_neighbourhood_criteria(p);
+            let mut r = Lcg(5);
+            for e in c.neighbourhood.as_mut().unwrap().strain.iter_mut() {
+                *e = Matrix2::new(
+                    r.next() - 0.5,
+                    0.3 * r.next(),
+                    0.3 * r.next(),
+                    r.next() - 0.5,
+                ) * 3e-3;
+            }
+        }
+        let n = p.len();
+        let mut want = c.clone();
+        let mut want_bt = vec![0.0; n];
+        let mut own = vec![Tensor::<2>::zeros(); n];
+        for i in 0..n {
+            want_bt[i] = update_state::<2, K, TwoSpring<2>, FULL>(
+                &m,
+                &c,
+                &x,
+                i,
+                &mut want.trial[i],
+                &mut want.sps_trial[i],
+                &mut want.cache[i],
+                nb.then_some(&mut own[i]),
+            );
+        }
+        let bits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
+        let state = |c: &Concrete<2, K>| {
+            let mut v = Vec::new();
+            for s in &c.trial {
+                v.extend([
+                    s.wt,
+                    s.wc,
+                    s.eps_init,
+                    s.initiated as u8 as f64,
+                    s.yielded as u8 as f64,
+                ]);
+            }
+            v.extend(c.sps_trial.iter().flatten());
+            for s in c.cache.iter().flatten() {
+                v.extend(s.e.iter());
+                v.extend([s.d_a_se, s.sd, s.d]);
+            }
+            if let Some(nb) = &c.neighbourhood {
+                v.extend(nb.strain_trial.iter().flat_map(|e| e.iter().copied()));
+            }
+            bits(&v)
+        };
+        if let Some(w) = want.neighbourhood.as_mut() {
+            w.strain_trial = own;
+        }
+        let expect = state(&want);
+        // damage of every kind reached the kernel
+        let d: Vec<f64> = want.cache.iter().flatten().map(|s| s.d).collect();
+        assert!(d.contains(&1.0) && d.iter().any(|&d| d > 0.0 && d < 1.0));
+        assert!(d.iter().filter(|&&d| d == 0.0).count() > n);
+        // and every branch of the law: initiation, and with FULL plastic flow
+        assert!(want
+            .trial
+            .iter()
+            .zip(&c.committed)
+            .any(|(t, s)| t.initiated && !s.initiated));
+        assert!(!FULL || want.trial.iter().filter(|s| s.yielded).count() > n / 20);
+        for simd in [true, false] {
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut got = c.clone();
+                got.simd = simd;
+                let mut bt = vec![0.0; n];
+                pool.install(|| pass_state::<2, K, TwoSpring<2>, FULL>(&m, &mut got, &x, &mut bt));
+                assert_eq!(
+                    bits(&bt),
+                    bits(&want_bt),
+                    "bθ, simd {simd}, {threads} threads"
+                );
+                assert!(
+                    state(&got) == expect,
+                    "state, simd {simd}, {threads} threads"
+                );
+            }
+        }
+        // whole steps (both passes, the law's commits) through the SIMD and the scalar paths
+        let mut st = crate::solver::kernel::State::at_rest(&p.x0);
+        let mut r = Lcg(17);
+        st.x.clone_from(&x);
+        for (v, f) in st.v.iter_mut().zip(st.force_prev.iter_mut()) {
+            *v = Vector2::new(r.next() - 0.5, r.next() - 0.5) * 1e-2;
+            *f = Vector2::new(r.next() - 0.5, r.next() - 0.5) * 1e3;
+        }
+        check_steps::<K, FULL, false, true>(&m, &c, &st);
+        check_steps::<K, FULL, true, false>(&m, &c, &st);
+    }
+
+    /// Three steps with and without the SIMD blocks: the same bits in every output.
+    fn check_steps<const K: usize, const FULL: bool, const LAG: bool, const DAMP: bool>(
+        m: &Mechanics<2, K>,
+        c: &Concrete<2, K>,
+        st0: &crate::solver::kernel::State<2>,
+    ) {
+        let run = |simd: bool| {
+            let (mut c, mut st) = (c.clone(), st0.clone());
+            c.simd = simd;
+            for _ in 0..3 {
+                step::<2, K, TwoSpring<2>, LAG, DAMP, FULL>(m, &mut c, &mut st, 1e-8);
+                std::mem::swap(&mut st.x, &mut st.x_next);
+                std::mem::swap(&mut st.v, &mut st.v_next);
+            }
+            let mut v: Vec<u64> = [&st.x, &st.v, &st.force]
+                .iter()
+                .flat_map(|a| a.iter().flat_map(|p| p.iter().map(|c| c.to_bits())))
+                .collect();
+            v.extend(
+                st.damping_work
+                    .iter()
+                    .chain(&st.b_theta)
+                    .map(|c| c.to_bits()),
+            );
+            for s in &c.committed {
+                v.extend([s.wt, s.wc, s.eps_init].map(f64::to_bits));
+            }
+            v
+        };
+        assert!(
+            run(true) == run(false),
+            "steps, LAG {LAG}, DAMP {DAMP}, FULL {FULL}"
+        );
+    }
+
+    /// A hexagonal block of 1,843 particles (not a multiple of 4) and a random one.
+    fn bodies() -> (Particles<2, 6>, Particles<2, { random::SLOTS_2D }>) {
+        let shape = Shape2::Rectangle {
+            origin: Vector2::zeros(),
+            width: 0.0405,
+            height: 0.0405,
+        };
+        let hex = HexLattice {
+            spacing: 1e-3,
+            rotation_deg: 10.0,
+            offset: Vector2::zeros(),
+            thickness: 0.1,
+        }
+        .fill(&shape);
+        let recipe = RandomParticles {
+            spacing: 2e-3,
+            min_distance: random::DEFAULT_MIN_DISTANCE,
+            seed: 3,
+            rotation_deg: 0.0,
+            thickness: 0.1,
+        };
+        let (rnd, _, _) = random::fill::<{ random::SLOTS_2D }>(&shape, &recipe).unwrap();
+        (hex, rnd)
+    }
+
+    #[test]
+    fn pass_state_simd_matches_scalar_bitwise() {
+        if !use_avx() {
+            eprintln!("no AVX on this CPU: only the scalar chunks are compared");
+        }
+        let (hex, rnd) = bodies();
+        assert!(hex.len() % LANES != 0, "{}", hex.len());
+        check_pass_state::<6, false>(&hex, false);
+        check_pass_state::<6, true>(&hex, false);
+        check_pass_state::<12, false>(&rnd, true);
+        check_pass_state::<12, true>(&rnd, true);
+    }
 
     /// Particle 0 with neighbours 1 and 2 (and an empty slot): the mean weighs each strain by
     /// its volume, and a damaged neighbour drops out of both the sum and the volume.

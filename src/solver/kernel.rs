@@ -644,7 +644,10 @@ pub(crate) mod avx {
     /// # Safety
     /// i0 + 4 ≤ m.len().
     #[inline(always)]
-    unsafe fn block_slots<const D: usize, const K: usize>(m: &Mechanics<D, K>, i0: usize) -> usize {
+    pub(crate) unsafe fn block_slots<const D: usize, const K: usize>(
+        m: &Mechanics<D, K>,
+        i0: usize,
+    ) -> usize {
         let e = |l: usize| *m.slot_end.get_unchecked(i0 + l) as usize;
         e(0).max(e(1)).max(e(2)).max(e(3))
     }
@@ -653,7 +656,7 @@ pub(crate) mod avx {
     /// empty) and the occupancy mask (all ones where occupied).
     #[target_feature(enable = "avx")]
     #[inline]
-    unsafe fn slot<const D: usize, const K: usize>(
+    pub(crate) unsafe fn slot<const D: usize, const K: usize>(
         m: &Mechanics<D, K>,
         i0: usize,
         k: usize,
@@ -693,14 +696,20 @@ pub(crate) mod avx {
     /// b_i·θ_i (θ_i = Σ_m w_im·S_im, w = 1 without weights) for particles i0..i0+4 into
     /// out[0..4]; with `CACHE`, also each slot's
     /// stretch and inverse length (both 0 where the slot is empty) into the block's part of
-    /// the bond cache at `cache` (see `super::bond_cache_at`).
+    /// the bond cache at `cache` (see `super::bond_cache_at`). `WEIGHTED` is whether the body
+    /// weighs its dilatations (`m.dilatation_weight`), a test hoisted out of the slot loop.
     ///
     /// # Safety
     /// AVX available; i0 + 4 ≤ m.len() = x.len(); every occupied slot indexes a particle;
     /// with `CACHE`, cache points to 8·K writable f64.
     #[target_feature(enable = "avx")]
     #[inline]
-    pub unsafe fn dilatation_block<const D: usize, const K: usize, const CACHE: bool>(
+    pub unsafe fn dilatation_block<
+        const D: usize,
+        const K: usize,
+        const CACHE: bool,
+        const WEIGHTED: bool,
+    >(
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
         i0: usize,
@@ -721,12 +730,12 @@ pub(crate) mod avx {
                 _mm256_storeu_pd(cache.add(2 * LANES * k + LANES), rinv);
             }
             // weighted dilatation (random particles): w·S, as the scalar path
-            let term = match &m.dilatation_weight {
-                Some(w) => {
+            let term = match (WEIGHTED, &m.dilatation_weight) {
+                (true, Some(w)) => {
                     let wk = |l: usize| *w.get_unchecked(i0 + l).get_unchecked(k);
                     _mm256_mul_pd(_mm256_set_pd(wk(3), wk(2), wk(1), wk(0)), st)
                 }
-                None => st,
+                _ => st,
             };
             s = _mm256_add_pd(s, term);
         }
@@ -846,7 +855,12 @@ pub(crate) mod avx {
             } else {
                 core::ptr::null_mut()
             };
-            dilatation_block::<D, K, CACHE>(m, x, base + o, out.as_mut_ptr().add(o), c);
+            // the weights' test hoisted out of the slot loop (one loop per case)
+            if m.dilatation_weight.is_some() {
+                dilatation_block::<D, K, CACHE, true>(m, x, base + o, out.as_mut_ptr().add(o), c);
+            } else {
+                dilatation_block::<D, K, CACHE, false>(m, x, base + o, out.as_mut_ptr().add(o), c);
+            }
         }
     }
 
