@@ -192,29 +192,7 @@ fn time_steps<const K: usize>(
         *x = x0 * (1.0 + strain);
     }
     let mut model = concrete.then(|| {
-        let cod_c = crate::scene::concrete::critical_crack_opening(81.4, 2.6168e6, 0.1, 0.25);
-        let law = crate::model::damage::ConcreteLaw {
-            e: 30e9,
-            nu: 0.2,
-            plane: Plane::Stress,
-            fc: 27.58e6,
-            ft: 2.6168e6,
-            fy: 22.983e6,
-            fult: 27.58e6,
-            gf: 81.4,
-            cod_c,
-            cod_1: 0.1 * cod_c,
-            gamma: 0.25,
-            eps_ult: 0.0035,
-            wt_cr: 1.0 / 3.0,
-            wc_max: 1.0,
-            initiation: crate::scene::Initiation::Rankine,
-            crack_opening: crate::scene::CrackOpening::Total,
-            tensile_damage: true,
-            compressive_damage: kernel == KernelSet::Full,
-            plasticity: kernel == KernelSet::Full,
-            crack_band: 2.8,
-        };
+        let law = crate::model::damage::ConcreteLaw::table1(kernel == KernelSet::Full);
         crate::solver::concrete::Concrete::<2, K>::new(
             crate::model::two_spring::TwoSpring::new(law, None),
             &p,

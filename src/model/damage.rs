@@ -48,6 +48,37 @@ pub struct LocalProperties {
 }
 
 impl ConcreteLaw {
+    /// The Table 1 concrete of 002 in plane stress (E = 30 GPa, ν = 0.2, f'c = 27.58 MPa,
+    /// f't = 2.6168 MPa, G_f = 81.4 N/m, α = 0.1, γ = 0.25, Rankine initiation, crack band
+    /// 2.8·L0) with tensile damage, and with compressive damage and plasticity where `full`:
+    /// the law `sppm bench` times.
+    pub fn table1(full: bool) -> ConcreteLaw {
+        let (ft, gf, alpha, gamma) = (2.6168e6, 81.4, 0.1, 0.25);
+        let cod_c = crate::scene::concrete::critical_crack_opening(gf, ft, alpha, gamma);
+        ConcreteLaw {
+            e: 30e9,
+            nu: 0.2,
+            plane: Plane::Stress,
+            fc: 27.58e6,
+            ft,
+            fy: 22.983e6,
+            fult: 27.58e6,
+            gf,
+            cod_c,
+            cod_1: alpha * cod_c,
+            gamma,
+            eps_ult: 0.0035,
+            wt_cr: 1.0 / 3.0,
+            wc_max: 1.0,
+            initiation: Initiation::Rankine,
+            crack_opening: CrackOpening::Total,
+            tensile_damage: true,
+            compressive_damage: full,
+            plasticity: full,
+            crack_band: 2.8,
+        }
+    }
+
     /// The concrete law of a resolved scene (`Scene::resolve`), if it has `[concrete]`.
     pub fn from_scene(scene: &Scene) -> Option<ConcreteLaw> {
         let c = scene.concrete.as_ref()?;

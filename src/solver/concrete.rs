@@ -856,32 +856,7 @@ mod tests {
 
     /// The bench's concrete law, with or without the compressive branch and plasticity.
     fn law(full: bool) -> TwoSpring<2> {
-        let cod_c = crate::scene::concrete::critical_crack_opening(81.4, 2.6168e6, 0.1, 0.25);
-        TwoSpring::new(
-            ConcreteLaw {
-                e: 30e9,
-                nu: 0.2,
-                plane: crate::scene::Plane::Stress,
-                fc: 27.58e6,
-                ft: 2.6168e6,
-                fy: 22.983e6,
-                fult: 27.58e6,
-                gf: 81.4,
-                cod_c,
-                cod_1: 0.1 * cod_c,
-                gamma: 0.25,
-                eps_ult: 0.0035,
-                wt_cr: 1.0 / 3.0,
-                wc_max: 1.0,
-                initiation: crate::scene::Initiation::Rankine,
-                crack_opening: crate::scene::CrackOpening::Total,
-                tensile_damage: true,
-                compressive_damage: full,
-                plasticity: full,
-                crack_band: 2.8,
-            },
-            None,
-        )
+        TwoSpring::new(ConcreteLaw::table1(full), None)
     }
 
     /// A block strained by up to ±2·f't/E per bond, with every kind of committed state:
