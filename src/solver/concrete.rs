@@ -73,7 +73,7 @@ where
     pub sps: Vec<[f64; K]>,
     sps_trial: Vec<[f64; K]>,
     /// Scratch from pass 1 for pass 2 of the same step.
-    cache: Vec<[SlotCache<D>; K]>,
+    cache: Vec<[SlotCache; K]>,
     /// Run the full kernel even where the law needs only the tension kernel (for tests that
     /// compare the two).
     pub force_full: bool,
@@ -207,31 +207,26 @@ where
     }
 }
 
-/// What pass 2 needs of one slot, left by pass 1 at the same positions and state: the unit
-/// vector, d·(a_i + a_j)·S_e, √d and d (0 everywhere in an empty slot).
-#[derive(Clone, Copy, Debug)]
-pub struct SlotCache<const D: usize> {
-    e: SVector<f64, D>,
+/// What pass 2 needs of one slot, left by pass 1 at the same positions and state: the inverse
+/// current length 1/|x_j − x_i|, d·(a_i + a_j)·S_e and d (0 everywhere in an empty slot).
+///
+/// **Decision (measured).** Pass 2 recomputes the unit vector e = (x_j − x_i)·(1/|x_j − x_i|)
+/// and √d (`d.sqrt()`, 1 where d = 1) rather than reading them: 24 bytes a slot instead of 40,
+/// which the memory-bound two-thread kernels feel, and the same operations on the same inputs
+/// as pass 1's, so the same bits (benchmarks/RESULTS.md, "Sixth attempt").
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SlotCache {
+    inv_len: f64,
     d_a_se: f64,
-    sd: f64,
     d: f64,
-}
-
-impl<const D: usize> Default for SlotCache<D> {
-    fn default() -> Self {
-        SlotCache {
-            e: SVector::zeros(),
-            d_a_se: 0.0,
-            sd: 0.0,
-            d: 0.0,
-        }
-    }
 }
 
 /// One slot's kinematics: unit vector, total stretch, elastic stretch, damage factor.
 #[derive(Clone, Copy)]
 struct Slot<const D: usize> {
     e: SVector<f64, D>,
+    /// 1/|x_j − x_i|.
+    inv_len: f64,
     st: f64,
     se: f64,
     d: f64,
@@ -273,8 +268,10 @@ where
     let (d, sd) = c
         .law
         .bond_factor::<FULL>(&c.committed[i], &c.committed[j], se);
+    let inv_len = 1.0 / len;
     Some(Slot {
-        e: dx * (1.0 / len),
+        e: dx * inv_len,
+        inv_len,
         st,
         se,
         d,
@@ -344,7 +341,7 @@ fn slot_pass<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: boo
     c: &Concrete<D, K, L>,
     x: &[SVector<f64, D>],
     i: usize,
-    cache: &mut [SlotCache<D>; K],
+    cache: &mut [SlotCache; K],
 ) -> Stretches<K>
 where
     Dim<D>: Dimension<D>,
@@ -363,9 +360,8 @@ where
                 s.theta_e += weighted(w, k, b.se);
                 s.same &= s.dse[k] == s.st[k];
                 SlotCache {
-                    e: b.e,
+                    inv_len: b.inv_len,
                     d_a_se: damaged_axial(b.d, m.a[i], m.a[j], b.se),
-                    sd: b.sd,
                     d: b.d,
                 }
             }
@@ -441,7 +437,7 @@ fn update_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: 
     i: usize,
     trial: &mut L::State,
     sps_trial: &mut [f64; K],
-    cache: &mut [SlotCache<D>; K],
+    cache: &mut [SlotCache; K],
     own_strain: Option<&mut Tensor<D>>,
 ) -> f64
 where
@@ -465,7 +461,7 @@ fn state_chunk<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: b
     b_theta: &mut [f64],
     trial: &mut [L::State],
     sps_trial: &mut [[f64; K]],
-    cache: &mut [[SlotCache<D>; K]],
+    cache: &mut [[SlotCache; K]],
     mut own: Option<&mut [Tensor<D>]>,
     avx: bool,
 ) where
@@ -586,11 +582,13 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
 }
 
 /// Internal force on particle i and the power of its bond dampers (half of each bond's),
-/// from the slot cache pass 1 left and every particle's bθ.
+/// from the slot cache pass 1 left at positions x and every particle's bθ; the unit vector
+/// and √d are recomputed as pass 1 computed them (see [`SlotCache`]).
 #[inline]
 fn particle_force<const D: usize, const K: usize, L: DamageLaw<D, K>, const DAMP: bool>(
     m: &Mechanics<D, K>,
     c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
     v: &[SVector<f64, D>],
     b_theta: &[f64],
     i: usize,
@@ -600,19 +598,22 @@ where
 {
     let mut f = SVector::<f64, D>::zeros();
     let mut power = 0.0;
+    let xi = x[i];
     for (s, &j) in c.cache[i].iter().zip(&m.neighbours[i]) {
         if s.d == 0.0 {
             continue;
         }
         let j = j as usize;
-        let mut fb = damaged_bond_force(s.d_a_se, s.sd, b_theta[i], b_theta[j]);
+        let e = (x[j] - xi) * s.inv_len;
+        let sd = if s.d == 1.0 { 1.0 } else { s.d.sqrt() };
+        let mut fb = damaged_bond_force(s.d_a_se, sd, b_theta[i], b_theta[j]);
         if DAMP {
             let cb = s.d * 0.5 * (m.c_in[i] + m.c_in[j]);
-            let rate = (v[j] - v[i]).dot(&s.e);
+            let rate = (v[j] - v[i]).dot(&e);
             fb += cb * rate;
             power += 0.5 * cb * rate * rate;
         }
-        f += s.e * fb;
+        f += e * fb;
     }
     (f, power)
 }
@@ -650,7 +651,7 @@ pub fn step<
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, (((xn, vn), fo), dw))| {
-                let (f, bond_power) = particle_force::<D, K, L, DAMP>(m, c, v, bt, i);
+                let (f, bond_power) = particle_force::<D, K, L, DAMP>(m, c, x, v, bt, i);
                 *fo = f;
                 let drive = if LAG { fp[i] } else { f };
                 central_difference::<D, K, DAMP>(
@@ -678,7 +679,7 @@ where
     }
     let c = &*c;
     (0..x.len())
-        .map(|i| particle_force::<D, K, L, false>(m, c, x, &bt, i).0)
+        .map(|i| particle_force::<D, K, L, false>(m, c, x, x, &bt, i).0)
         .collect()
 }
 
@@ -954,8 +955,7 @@ mod tests {
             }
             v.extend(c.sps_trial.iter().flatten());
             for s in c.cache.iter().flatten() {
-                v.extend(s.e.iter());
-                v.extend([s.d_a_se, s.sd, s.d]);
+                v.extend([s.inv_len, s.d_a_se, s.d]);
             }
             if let Some(nb) = &c.neighbourhood {
                 v.extend(nb.strain_trial.iter().flat_map(|e| e.iter().copied()));

@@ -107,7 +107,7 @@ pub(super) unsafe fn slot_block<
     c: &Concrete<D, K, L>,
     x: &[SVector<f64, D>],
     i0: usize,
-    cache: &mut [[SlotCache<D>; K]],
+    cache: &mut [[SlotCache; K]],
     out: &mut [Stretches<K>; LANES],
 ) where
     Dim<D>: Dimension<D>,
@@ -130,7 +130,7 @@ pub(super) unsafe fn slot_block<
         // its division and square root overlap the length's)
         let (wtj, wcj) = series_damage(c, j);
         let (dt, sdt) = series(wti, wtj);
-        let (dv, len) = geometry(&xi, &gather_vec(x, &j));
+        let (_, len) = geometry(&xi, &gather_vec(x, &j));
         // total_stretch: len·(1/L0) − 1
         let st = _mm256_and_pd(_mm256_sub_pd(_mm256_mul_pd(len, il), one), occ);
         // S_e = S_T − ½(S_Ps,ij + S_Ps,ji) (3.38)
@@ -171,12 +171,8 @@ pub(super) unsafe fn slot_block<
             )
         };
         let (d, sd) = (_mm256_and_pd(d, occ), _mm256_and_pd(sd, occ));
-        // e = dx·(1/len)
-        let rinv = _mm256_div_pd(one, len);
-        let mut e = [zero; D];
-        for (ec, dc) in e.iter_mut().zip(&dv) {
-            *ec = _mm256_and_pd(_mm256_mul_pd(*dc, rinv), occ);
-        }
+        // 1/len, from which pass 2 recomputes e = dx·(1/len)
+        let rinv = _mm256_and_pd(_mm256_div_pd(one, len), occ);
         // damaged_axial: d·((a_i + a_j)·S_e)
         let aj = gather(&m.a, &j);
         let d_a_se = _mm256_mul_pd(d, _mm256_mul_pd(_mm256_add_pd(ai, aj), se));
@@ -199,25 +195,16 @@ pub(super) unsafe fn slot_block<
         theta_e = _mm256_add_pd(theta_e, _mm256_and_pd(te, occ));
         same = _mm256_and_pd(same, _mm256_cmp_pd::<_CMP_EQ_OQ>(dse, st));
         let (st, se, dse, occ) = (lanes(st), lanes(se), lanes(dse), lanes(occ));
-        let (d_a_se, sd, d) = (lanes(d_a_se), lanes(sd), lanes(d));
-        let mut el = [[0.0; 4]; D];
-        for (el, e) in el.iter_mut().zip(&e) {
-            *el = lanes(*e);
-        }
+        let (d_a_se, d, rinv) = (lanes(d_a_se), lanes(d), lanes(rinv));
         for l in 0..LANES {
-            let mut ev = SVector::<f64, D>::zeros();
-            for cc in 0..D {
-                ev[cc] = el[cc][l];
-            }
             let o = out.get_unchecked_mut(l);
             *o.st.get_unchecked_mut(k) = st[l];
             *o.se.get_unchecked_mut(k) = se[l];
             *o.dse.get_unchecked_mut(k) = dse[l];
             *o.used.get_unchecked_mut(k) = occ[l].to_bits() != 0;
             *cache.get_unchecked_mut(l).get_unchecked_mut(k) = SlotCache {
-                e: ev,
+                inv_len: rinv[l],
                 d_a_se: d_a_se[l],
-                sd: sd[l],
                 d: d[l],
             };
         }
