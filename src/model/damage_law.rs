@@ -19,8 +19,7 @@
 //!    compressive branch ([`Kernel::Full`]) or not ([`Kernel::Tension`]).
 //! 3. [`DamageLaw::bond_factor`]: the factor d ∈ [0, 1] (and √d) a bond between two particles
 //!    carries, from their committed states and the sign of its elastic stretch. It must be
-//!    symmetric bit for bit in (i, j), so that the two ends of a bond see the same force, and
-//!    its √d must be `d.sqrt()` (pass 2 recomputes it from d).
+//!    symmetric bit for bit in (i, j), so that the two ends of a bond see the same force.
 //! 4. [`DamageLaw::update`]: the particle's trial state (and plastic stretch increments, for a
 //!    [`Kernel::Full`] law) from its bonds' stretches ([`ParticleBonds`]: total, elastic,
 //!    damaged, the strain fit, its micro-modulus and length scale).
@@ -121,9 +120,7 @@ where
     fn kernel(&self) -> Kernel;
 
     /// (d, √d) of a bond between particles in states `i` and `j` with elastic stretch
-    /// `elastic_stretch`; `FULL` is the kernel running ([`Kernel::Full`]). The second value
-    /// must be `d.sqrt()` bit for bit (1 where d = 1): pass 2 of the kernel recomputes it
-    /// from d rather than storing it (`solver::concrete::SlotCache`).
+    /// `elastic_stretch`; `FULL` is the kernel running ([`Kernel::Full`]).
     fn bond_factor<const FULL: bool>(
         &self,
         i: &Self::State,

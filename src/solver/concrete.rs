@@ -13,8 +13,12 @@
 //!    Where the law's bond factor is the two springs in series ([`DamageLaw::SERIES_DAMAGE`])
 //!    and the CPU has AVX, the slot loop runs four particles at a time (`avx::slot_block`,
 //!    bit-identical to `slot_pass`; `tests::pass_state_simd_matches_scalar_bitwise`).
+//!    Pass 1 leaves each slot's 1/length, d·(a_i + a_j)·S_e, √d and d in the slot cache
+//!    ([`SlotCache`], blocks of four particles).
 //! 2. Each particle gathers F_b,ij = ½(d_ij·(a_i + a_j)·S_e,ij + √d_ij·(bθ_i + bθ_j)) along
-//!    e_ij, with the bond damper scaled by d_ij, and integrates.
+//!    e_ij, with the bond damper scaled by d_ij, and integrates. With AVX in 2D, four particles
+//!    at a time (`avx::force_block`, for any law: it reads only the slot cache), bit-identical
+//!    to `particle_force` (the same test, three whole steps).
 //!
 //! **Decision (erratum to (3.36)).** As written, F_s,ij = d_ij·a·S_e,ij + b·Σ_m d_im·S_e,im
 //! leaves the dilatation term on a bond whose particle is fully damaged: a broken particle i
@@ -34,7 +38,7 @@
 //! (`model::two_spring`) is one implementation. This kernel computes the kinematics, asks the
 //! law for each bond's damage factor and each particle's new state, and moves the particles.
 
-use super::kernel::{central_difference, chunk_len, use_avx, LANES};
+use super::kernel::{central_difference, chunk_len, update_in_chunks, use_avx, ChunkOut, LANES};
 use super::mechanics::{weighted, Mechanics};
 use super::KernelSet;
 use crate::discretise::{Particles, NONE};
@@ -72,8 +76,9 @@ where
     /// Committed plastic stretch states S_Ps,ij (3.48), per slot.
     pub sps: Vec<[f64; K]>,
     sps_trial: Vec<[f64; K]>,
-    /// Scratch from pass 1 for pass 2 of the same step.
-    cache: Vec<[SlotCache; K]>,
+    /// Scratch from pass 1 for pass 2 of the same step, in blocks of [`LANES`] particles
+    /// (see [`slot_cache_at`]).
+    cache: Vec<f64>,
     /// Run the full kernel even where the law needs only the tension kernel (for tests that
     /// compare the two).
     pub force_full: bool,
@@ -164,7 +169,7 @@ where
             trial: vec![L::State::default(); n],
             sps: vec![[0.0; K]; n],
             sps_trial: vec![[0.0; K]; n],
-            cache: vec![[SlotCache::default(); K]; n],
+            cache: vec![0.0; slot_cache_len(n, K)],
             force_full: false,
             neighbourhood: None,
             simd: true,
@@ -208,17 +213,54 @@ where
 }
 
 /// What pass 2 needs of one slot, left by pass 1 at the same positions and state: the inverse
-/// current length 1/|x_j − x_i|, d·(a_i + a_j)·S_e and d (0 everywhere in an empty slot).
+/// current length 1/|x_j − x_i|, d·(a_i + a_j)·S_e, √d and d (0 everywhere in an empty slot).
 ///
-/// **Decision (measured).** Pass 2 recomputes the unit vector e = (x_j − x_i)·(1/|x_j − x_i|)
-/// and √d (`d.sqrt()`, 1 where d = 1) rather than reading them: 24 bytes a slot instead of 40,
-/// which the memory-bound two-thread kernels feel, and the same operations on the same inputs
-/// as pass 1's, so the same bits (benchmarks/RESULTS.md, "Sixth attempt").
-#[derive(Clone, Copy, Debug, Default)]
+/// **Decision (measured).** Pass 2 recomputes the unit vector e = (x_j − x_i)·(1/|x_j − x_i|),
+/// the same operations on the same inputs as pass 1's, so the same bits, rather than reading
+/// it: 32 bytes a slot instead of 40. The cache is laid out in blocks of [`LANES`] particles,
+/// each field of a slot four lanes wide ([`slot_cache_at`]), so that the AVX passes load and
+/// store it a vector at a time (benchmarks/RESULTS.md, "Sixth attempt").
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SlotCache {
     inv_len: f64,
     d_a_se: f64,
+    sd: f64,
     d: f64,
+}
+
+/// The slot cache's fields per slot.
+const FIELDS: usize = 4;
+
+/// Length of the slot cache of n particles with k slots each.
+pub(crate) const fn slot_cache_len(n: usize, k: usize) -> usize {
+    n.div_ceil(LANES) * LANES * FIELDS * k
+}
+
+/// Index in the slot cache of the first field (1/length) of slot k of particle i; the fields
+/// d·(a_i + a_j)·S_e, √d and d follow [`LANES`] entries apart each.
+#[inline(always)]
+pub(crate) const fn slot_cache_at(i: usize, k: usize, slots: usize) -> usize {
+    (i / LANES) * (FIELDS * LANES * slots) + FIELDS * LANES * k + i % LANES
+}
+
+impl SlotCache {
+    #[inline(always)]
+    fn read(cache: &[f64], at: usize) -> Self {
+        SlotCache {
+            inv_len: cache[at],
+            d_a_se: cache[at + LANES],
+            sd: cache[at + 2 * LANES],
+            d: cache[at + 3 * LANES],
+        }
+    }
+
+    #[inline(always)]
+    fn write(self, cache: &mut [f64], at: usize) {
+        cache[at] = self.inv_len;
+        cache[at + LANES] = self.d_a_se;
+        cache[at + 2 * LANES] = self.sd;
+        cache[at + 3 * LANES] = self.d;
+    }
 }
 
 /// One slot's kinematics: unit vector, total stretch, elastic stretch, damage factor.
@@ -333,23 +375,25 @@ impl<const K: usize> Default for Stretches<K> {
     }
 }
 
-/// Pass 1's slot loop for particle i: its [`Stretches`] and the slot cache for pass 2
-/// (the scalar path; `avx::slot_block` does four particles at once, bit for bit the same).
+/// Pass 1's slot loop for particle i: its [`Stretches`] and the slot cache for pass 2 into
+/// `cache`, in which i is particle `p` (the scalar path; `avx::slot_block` does four particles
+/// at once, bit for bit the same).
 #[inline(always)]
 fn slot_pass<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bool>(
     m: &Mechanics<D, K>,
     c: &Concrete<D, K, L>,
     x: &[SVector<f64, D>],
     i: usize,
-    cache: &mut [SlotCache; K],
+    cache: &mut [f64],
+    p: usize,
 ) -> Stretches<K>
 where
     Dim<D>: Dimension<D>,
 {
     let mut s = Stretches::<K>::default();
     let w = m.weights(i);
-    for (k, ca) in cache.iter_mut().enumerate() {
-        *ca = match slot::<D, K, L, FULL>(m, c, x, i, k) {
+    for k in 0..K {
+        let sc = match slot::<D, K, L, FULL>(m, c, x, i, k) {
             Some(b) => {
                 let j = m.neighbours[i][k] as usize;
                 s.st[k] = b.st;
@@ -362,11 +406,13 @@ where
                 SlotCache {
                     inv_len: b.inv_len,
                     d_a_se: damaged_axial(b.d, m.a[i], m.a[j], b.se),
+                    sd: b.sd,
                     d: b.d,
                 }
             }
             None => SlotCache::default(),
         };
+        sc.write(cache, slot_cache_at(p, k, K));
     }
     s
 }
@@ -423,8 +469,8 @@ where
     dilatation_term(m.b[i], s.theta)
 }
 
-/// Pass 1 for particle i: bθ_i, the slot cache for pass 2, and the trial law state and
-/// plastic stretch state (from the law, [`DamageLaw::update`]).
+/// Pass 1 for particle i: bθ_i, the slot cache for pass 2 (i is particle `p` of `cache`), and
+/// the trial law state and plastic stretch state (from the law, [`DamageLaw::update`]).
 ///
 /// `FULL = false` is the tension kernel: it reads no plastic stretch.
 #[inline(always)]
@@ -437,13 +483,14 @@ fn update_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: 
     i: usize,
     trial: &mut L::State,
     sps_trial: &mut [f64; K],
-    cache: &mut [SlotCache; K],
+    cache: &mut [f64],
+    p: usize,
     own_strain: Option<&mut Tensor<D>>,
 ) -> f64
 where
     Dim<D>: Dimension<D>,
 {
-    let s = slot_pass::<D, K, L, FULL>(m, c, x, i, cache);
+    let s = slot_pass::<D, K, L, FULL>(m, c, x, i, cache, p);
     law_pass::<D, K, L, FULL>(m, c, i, &s, trial, sps_trial, own_strain)
 }
 
@@ -461,7 +508,7 @@ fn state_chunk<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: b
     b_theta: &mut [f64],
     trial: &mut [L::State],
     sps_trial: &mut [[f64; K]],
-    cache: &mut [[SlotCache; K]],
+    cache: &mut [f64],
     mut own: Option<&mut [Tensor<D>]>,
     avx: bool,
 ) where
@@ -469,7 +516,7 @@ fn state_chunk<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: b
 {
     let n = b_theta.len();
     assert!(base + n <= m.len() && m.len() == x.len());
-    assert!(trial.len() == n && sps_trial.len() == n && cache.len() == n);
+    assert!(trial.len() == n && sps_trial.len() == n && cache.len() == slot_cache_len(n, K));
     assert!(own.as_ref().is_none_or(|o| o.len() == n));
     #[cfg(target_arch = "x86_64")]
     let done = if avx {
@@ -477,9 +524,10 @@ fn state_chunk<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: b
         let mut s = [Stretches::<K>::default(); LANES];
         for o in (0..done).step_by(LANES) {
             // SAFETY: AVX is available (`use_avx`, checked by the caller); base + o + 4 ≤
-            // m.len() = x.len() and cache[o..o + 4] exists (asserted above); Mechanics::new
-            // checks every occupied slot indexes a particle.
-            let ca = &mut cache[o..o + LANES];
+            // m.len() = x.len() and the block's cache exists (asserted above);
+            // Mechanics::new checks every occupied slot indexes a particle.
+            let at = slot_cache_at(o, 0, K);
+            let ca = &mut cache[at..at + FIELDS * LANES * K];
             unsafe {
                 if m.dilatation_weight.is_some() {
                     avx::slot_block::<D, K, L, FULL, true>(m, c, x, base + o, ca, &mut s)
@@ -517,7 +565,8 @@ fn state_chunk<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: b
             base + p,
             &mut trial[p],
             &mut sps_trial[p],
-            &mut cache[p],
+            cache,
+            p,
             own.as_deref_mut().map(|own| &mut own[p]),
         );
     }
@@ -549,7 +598,7 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
             .par_chunks_mut(chunk)
             .zip(trial.par_chunks_mut(chunk))
             .zip(sps_trial.par_chunks_mut(chunk))
-            .zip(cache.par_chunks_mut(chunk))
+            .zip(cache.par_chunks_mut(slot_cache_len(chunk, K)))
             .enumerate();
         match &mut strain_trial {
             Some(own) => zipped.zip(own.par_chunks_mut(chunk)).for_each(
@@ -582,8 +631,9 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
 }
 
 /// Internal force on particle i and the power of its bond dampers (half of each bond's),
-/// from the slot cache pass 1 left at positions x and every particle's bθ; the unit vector
-/// and √d are recomputed as pass 1 computed them (see [`SlotCache`]).
+/// from the slot cache pass 1 left at positions x and every particle's bθ; the unit vector is
+/// recomputed as pass 1 computed it (see [`SlotCache`]). `avx::force_block` does four
+/// particles at once, bit for bit the same.
 #[inline]
 fn particle_force<const D: usize, const K: usize, L: DamageLaw<D, K>, const DAMP: bool>(
     m: &Mechanics<D, K>,
@@ -599,14 +649,14 @@ where
     let mut f = SVector::<f64, D>::zeros();
     let mut power = 0.0;
     let xi = x[i];
-    for (s, &j) in c.cache[i].iter().zip(&m.neighbours[i]) {
+    for (k, &j) in m.neighbours[i].iter().enumerate() {
+        let s = SlotCache::read(&c.cache, slot_cache_at(i, k, K));
         if s.d == 0.0 {
             continue;
         }
         let j = j as usize;
         let e = (x[j] - xi) * s.inv_len;
-        let sd = if s.d == 1.0 { 1.0 } else { s.d.sqrt() };
-        let mut fb = damaged_bond_force(s.d_a_se, sd, b_theta[i], b_theta[j]);
+        let mut fb = damaged_bond_force(s.d_a_se, s.sd, b_theta[i], b_theta[j]);
         if DAMP {
             let cb = s.d * 0.5 * (m.c_in[i] + m.c_in[j]);
             let rate = (v[j] - v[i]).dot(&e);
@@ -640,25 +690,46 @@ pub fn step<
 {
     debug_assert!(FULL || c.kernel() == KernelSet::Tension);
     pass_state::<D, K, L, FULL>(m, c, &st.x, &mut st.b_theta);
-    {
-        let c = &*c;
-        let (x, v, bt, fp) = (&st.x[..], &st.v[..], &st.b_theta[..], &st.force_prev[..]);
-        st.x_next
-            .par_iter_mut()
-            .zip(st.v_next.par_iter_mut())
-            .zip(st.force.par_iter_mut())
-            .zip(st.damping_work.par_iter_mut())
-            .enumerate()
-            .with_min_len(256)
-            .for_each(|(i, (((xn, vn), fo), dw))| {
-                let (f, bond_power) = particle_force::<D, K, L, DAMP>(m, c, x, v, bt, i);
-                *fo = f;
-                let drive = if LAG { fp[i] } else { f };
-                central_difference::<D, K, DAMP>(
-                    m, i, x[i], v[i], drive, bond_power, dt, xn, vn, dw,
-                );
-            });
-    }
+    #[cfg(target_arch = "x86_64")]
+    let avx = c.simd && use_avx() && super::kernel::avx::vector_update::<D>();
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx = false;
+    let cr = &*c;
+    update_in_chunks(st, m.len(), |base, r, out| {
+        let ChunkOut { xn, vn, fo, dw } = out;
+        let len = xn.len();
+        let done = if avx { len / LANES * LANES } else { 0 };
+        #[cfg(target_arch = "x86_64")]
+        if done > 0 {
+            // SAFETY: AVX is available and D = 2 with 16-byte vectors (checked above);
+            // base + len ≤ m.len() and every state array has m.len() entries
+            // (update_in_chunks asserts it); pass 1 filled the slot cache of every particle.
+            unsafe {
+                avx::update_chunk::<D, K, L, LAG, DAMP>(
+                    m,
+                    cr,
+                    &r,
+                    dt,
+                    base,
+                    ChunkOut {
+                        xn: &mut xn[..done],
+                        vn: &mut vn[..done],
+                        fo: &mut fo[..done],
+                        dw: &mut dw[..done],
+                    },
+                )
+            }
+        }
+        for o in done..len {
+            let i = base + o;
+            let (f, bond_power) = particle_force::<D, K, L, DAMP>(m, cr, r.x, r.v, r.b_theta, i);
+            fo[o] = f;
+            let drive = if LAG { r.force_prev[i] } else { f };
+            central_difference::<D, K, DAMP>(
+                m, i, r.x[i], r.v[i], drive, bond_power, dt, &mut xn[o], &mut vn[o], &mut dw[o],
+            );
+        }
+    });
     c.commit();
 }
 
@@ -937,7 +1008,8 @@ mod tests {
                 i,
                 &mut want.trial[i],
                 &mut want.sps_trial[i],
-                &mut want.cache[i],
+                &mut want.cache,
+                i,
                 nb.then_some(&mut own[i]),
             );
         }
@@ -954,9 +1026,7 @@ mod tests {
                 ]);
             }
             v.extend(c.sps_trial.iter().flatten());
-            for s in c.cache.iter().flatten() {
-                v.extend([s.inv_len, s.d_a_se, s.d]);
-            }
+            v.extend(&c.cache);
             if let Some(nb) = &c.neighbourhood {
                 v.extend(nb.strain_trial.iter().flat_map(|e| e.iter().copied()));
             }
@@ -967,7 +1037,10 @@ mod tests {
         }
         let expect = state(&want);
         // damage of every kind reached the kernel
-        let d: Vec<f64> = want.cache.iter().flatten().map(|s| s.d).collect();
+        let d: Vec<f64> = (0..n)
+            .flat_map(|i| (0..K).map(move |k| (i, k)))
+            .map(|(i, k)| SlotCache::read(&want.cache, slot_cache_at(i, k, K)).d)
+            .collect();
         assert!(d.contains(&1.0) && d.iter().any(|&d| d > 0.0 && d < 1.0));
         assert!(d.iter().filter(|&&d| d == 0.0).count() > n);
         // and every branch of the law: initiation, and with FULL plastic flow

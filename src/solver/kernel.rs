@@ -878,6 +878,95 @@ pub(crate) mod avx {
         _mm256_storeu_pd(p.add(4), _mm256_permute2f128_pd(a, b, 0x31));
     }
 
+    /// Whether [`update_block`] applies: D = 2 with 16-byte vectors.
+    #[inline(always)]
+    pub(crate) fn vector_update<const D: usize>() -> bool {
+        D == 2 && std::mem::size_of::<SVector<f64, D>>() == 16
+    }
+
+    /// The central-difference update (`super::update_one`) of particles i0..i0+4 (chunk
+    /// positions o0..o0+4 of xn, vn, fo, dw) from their internal forces `f` (per component,
+    /// one per lane) and bond-damper power, the same operations in the same order per lane.
+    /// Shared by the elastic and the concrete kernels.
+    ///
+    /// # Safety
+    /// AVX available; [`vector_update`]; i0 + 4 ≤ x.len() = v.len() = force_prev.len() =
+    /// m.len(); o0 + 4 ≤ the length of xn, vn, fo and dw.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) unsafe fn update_block<
+        const D: usize,
+        const K: usize,
+        const LAG: bool,
+        const DAMP: bool,
+    >(
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        v: &[SVector<f64, D>],
+        force_prev: &[SVector<f64, D>],
+        dt: f64,
+        i0: usize,
+        o0: usize,
+        f: &[__m256d; D],
+        power: __m256d,
+        xn: &mut [SVector<f64, D>],
+        vn: &mut [SVector<f64, D>],
+        fo: &mut [SVector<f64, D>],
+        dw: &mut [f64],
+    ) {
+        let one = _mm256_set1_pd(1.0);
+        let half = _mm256_set1_pd(0.5);
+        let zero = _mm256_setzero_pd();
+        let dtv = _mm256_set1_pd(dt);
+        let half_dt = _mm256_set1_pd(0.5 * dt);
+        // super::update_one per lane, the same operations in the same order.
+        store_own2(fo, o0, f);
+        let drive = if LAG { load_own(force_prev, i0) } else { *f };
+        let cex = _mm256_loadu_pd(m.c_ex.as_ptr().add(i0));
+        let im = _mm256_loadu_pd(m.inv_mass.as_ptr().add(i0));
+        // h = 0.5 * dt * c_ex * inv_mass
+        let h = _mm256_mul_pd(_mm256_mul_pd(half_dt, cex), im);
+        let one_m_h = _mm256_sub_pd(one, h);
+        let one_p_h = _mm256_add_pd(one, h);
+        let dt_im = _mm256_mul_pd(dtv, im);
+        let vi = load_own(v, i0);
+        let xi = load_own(x, i0);
+        let mut vnew = [zero; D];
+        let mut xnew = [zero; D];
+        for c in 0..D {
+            vnew[c] = _mm256_div_pd(
+                _mm256_add_pd(
+                    _mm256_mul_pd(vi[c], one_m_h),
+                    _mm256_mul_pd(drive[c], dt_im),
+                ),
+                one_p_h,
+            );
+            xnew[c] = _mm256_add_pd(xi[c], _mm256_mul_pd(vnew[c], dtv));
+        }
+        store_own2(vn, o0, &vnew);
+        store_own2(xn, o0, &xnew);
+        // dw += dt * (bond_power + c_ex * |½(v_i + v_new)|²) where DAMP or h ≠ 0
+        let mut vm2 = zero;
+        for c in 0..D {
+            let vm = _mm256_mul_pd(_mm256_add_pd(vi[c], vnew[c]), half);
+            let sq = _mm256_mul_pd(vm, vm);
+            vm2 = if c == 0 { sq } else { _mm256_add_pd(vm2, sq) };
+        }
+        let pw = dw.as_mut_ptr().add(o0);
+        let old = _mm256_loadu_pd(pw);
+        let new = _mm256_add_pd(
+            old,
+            _mm256_mul_pd(dtv, _mm256_add_pd(power, _mm256_mul_pd(cex, vm2))),
+        );
+        let new = if DAMP {
+            new
+        } else {
+            _mm256_blendv_pd(old, new, _mm256_cmp_pd::<_CMP_NEQ_UQ>(h, zero))
+        };
+        _mm256_storeu_pd(pw, new);
+    }
+
     /// Pass 2 over whole blocks: the slices hold particles base.., a multiple of 4 of them.
     ///
     /// # Safety
@@ -906,61 +995,14 @@ pub(crate) mod avx {
             dt,
         } = inp;
         let ChunkOut { xn, vn, fo, dw } = out;
-        let vector_update = D == 2 && std::mem::size_of::<SVector<f64, D>>() == 16;
-        let one = _mm256_set1_pd(1.0);
-        let half = _mm256_set1_pd(0.5);
-        let zero = _mm256_setzero_pd();
-        let dtv = _mm256_set1_pd(dt);
-        let half_dt = _mm256_set1_pd(0.5 * dt);
+        let vector_update = vector_update::<D>();
         for o0 in (0..xn.len()).step_by(4) {
             let i0 = base + o0;
             let (f, power) = force_block::<D, K, DAMP, CACHE>(m, x, v, b_theta, cache, i0);
             if vector_update {
-                // super::update_one per lane, the same operations in the same order.
-                store_own2(fo, o0, &f);
-                let drive = if LAG { load_own(force_prev, i0) } else { f };
-                let cex = _mm256_loadu_pd(m.c_ex.as_ptr().add(i0));
-                let im = _mm256_loadu_pd(m.inv_mass.as_ptr().add(i0));
-                // h = 0.5 * dt * c_ex * inv_mass
-                let h = _mm256_mul_pd(_mm256_mul_pd(half_dt, cex), im);
-                let one_m_h = _mm256_sub_pd(one, h);
-                let one_p_h = _mm256_add_pd(one, h);
-                let dt_im = _mm256_mul_pd(dtv, im);
-                let vi = load_own(v, i0);
-                let xi = load_own(x, i0);
-                let mut vnew = [zero; D];
-                let mut xnew = [zero; D];
-                for c in 0..D {
-                    vnew[c] = _mm256_div_pd(
-                        _mm256_add_pd(
-                            _mm256_mul_pd(vi[c], one_m_h),
-                            _mm256_mul_pd(drive[c], dt_im),
-                        ),
-                        one_p_h,
-                    );
-                    xnew[c] = _mm256_add_pd(xi[c], _mm256_mul_pd(vnew[c], dtv));
-                }
-                store_own2(vn, o0, &vnew);
-                store_own2(xn, o0, &xnew);
-                // dw += dt * (bond_power + c_ex * |½(v_i + v_new)|²) where DAMP or h ≠ 0
-                let mut vm2 = zero;
-                for c in 0..D {
-                    let vm = _mm256_mul_pd(_mm256_add_pd(vi[c], vnew[c]), half);
-                    let sq = _mm256_mul_pd(vm, vm);
-                    vm2 = if c == 0 { sq } else { _mm256_add_pd(vm2, sq) };
-                }
-                let pw = dw.as_mut_ptr().add(o0);
-                let old = _mm256_loadu_pd(pw);
-                let new = _mm256_add_pd(
-                    old,
-                    _mm256_mul_pd(dtv, _mm256_add_pd(power, _mm256_mul_pd(cex, vm2))),
+                update_block::<D, K, LAG, DAMP>(
+                    m, x, v, force_prev, dt, i0, o0, &f, power, xn, vn, fo, dw,
                 );
-                let new = if DAMP {
-                    new
-                } else {
-                    _mm256_blendv_pd(old, new, _mm256_cmp_pd::<_CMP_NEQ_UQ>(h, zero))
-                };
-                _mm256_storeu_pd(pw, new);
                 continue;
             }
             let mut fa = [[0.0; 4]; D];

@@ -6,12 +6,15 @@
 //! damaged axial term and the dilatation sums (§6). The law update of each particle stays
 //! scalar (`law_pass`).
 
-use super::{Concrete, SlotCache, Stretches};
+use super::{slot_cache_at, Concrete, Stretches, FIELDS};
 use crate::discretise::NONE;
 use crate::model::damage_law::DamageLaw;
 use crate::model::dimension::{Dim, Dimension};
-use crate::solver::kernel::avx::{block_slots, gather, gather_vec, geometry, load_own, slot};
+use crate::solver::kernel::avx::{
+    block_slots, gather, gather_vec, geometry, load_own, slot, update_block,
+};
 use crate::solver::kernel::LANES;
+use crate::solver::kernel::{ChunkOut, StateReads};
 use crate::solver::mechanics::Mechanics;
 use core::arch::x86_64::*;
 use nalgebra::SVector;
@@ -86,14 +89,14 @@ unsafe fn series(wi: __m256d, wj: __m256d) -> (__m256d, __m256d) {
 }
 
 /// The slot loop of `slot_pass` for particles i0..i0+4: their stretches into `out` (every
-/// field written) and their slot caches into `cache` (the four particles').
+/// field written) and their slot caches into `cache` (the block's part of the slot cache).
 ///
 /// `WEIGHTED` is whether the body weighs its dilatations (`m.dilatation_weight`), a test
 /// hoisted out of the slot loop.
 ///
 /// # Safety
 /// AVX available; `L::SERIES_DAMAGE`; i0 + 4 ≤ m.len() = x.len() = c.committed.len(); every
-/// occupied slot indexes a particle; cache.len() = 4.
+/// occupied slot indexes a particle; cache.len() = 4·4·K.
 #[target_feature(enable = "avx")]
 #[inline]
 pub(super) unsafe fn slot_block<
@@ -107,12 +110,13 @@ pub(super) unsafe fn slot_block<
     c: &Concrete<D, K, L>,
     x: &[SVector<f64, D>],
     i0: usize,
-    cache: &mut [[SlotCache; K]],
+    cache: &mut [f64],
     out: &mut [Stretches<K>; LANES],
 ) where
     Dim<D>: Dimension<D>,
 {
-    debug_assert!(L::SERIES_DAMAGE && cache.len() == LANES);
+    debug_assert!(L::SERIES_DAMAGE && cache.len() == FIELDS * LANES * K);
+    let blk = cache.as_mut_ptr();
     let zero = _mm256_setzero_pd();
     let one = _mm256_set1_pd(1.0);
     let half = _mm256_set1_pd(0.5);
@@ -195,24 +199,28 @@ pub(super) unsafe fn slot_block<
         theta_e = _mm256_add_pd(theta_e, _mm256_and_pd(te, occ));
         same = _mm256_and_pd(same, _mm256_cmp_pd::<_CMP_EQ_OQ>(dse, st));
         let (st, se, dse, occ) = (lanes(st), lanes(se), lanes(dse), lanes(occ));
-        let (d_a_se, d, rinv) = (lanes(d_a_se), lanes(d), lanes(rinv));
+        let p = blk.add(FIELDS * LANES * k);
+        _mm256_storeu_pd(p, rinv);
+        _mm256_storeu_pd(p.add(LANES), d_a_se);
+        _mm256_storeu_pd(p.add(2 * LANES), sd);
+        _mm256_storeu_pd(p.add(3 * LANES), d);
         for l in 0..LANES {
             let o = out.get_unchecked_mut(l);
             *o.st.get_unchecked_mut(k) = st[l];
             *o.se.get_unchecked_mut(k) = se[l];
             *o.dse.get_unchecked_mut(k) = dse[l];
             *o.used.get_unchecked_mut(k) = occ[l].to_bits() != 0;
-            *cache.get_unchecked_mut(l).get_unchecked_mut(k) = SlotCache {
-                inv_len: rinv[l],
-                d_a_se: d_a_se[l],
-                d: d[l],
-            };
+        }
+    }
+    for k in ns..K {
+        let p = blk.add(FIELDS * LANES * k);
+        for f in 0..FIELDS {
+            _mm256_storeu_pd(p.add(f * LANES), zero);
         }
     }
     for l in 0..LANES {
         let o = out.get_unchecked_mut(l);
         for k in ns..K {
-            *cache.get_unchecked_mut(l).get_unchecked_mut(k) = SlotCache::default();
             *o.st.get_unchecked_mut(k) = 0.0;
             *o.se.get_unchecked_mut(k) = 0.0;
             *o.dse.get_unchecked_mut(k) = 0.0;
@@ -225,5 +233,149 @@ pub(super) unsafe fn slot_block<
         o.theta = theta[l];
         o.theta_e = theta_e[l];
         o.same = same[l].to_bits() != 0;
+    }
+}
+
+/// Neighbours in slot k of particles i0..i0+4 (the particle itself where the slot is empty).
+///
+/// # Safety
+/// i0 + 4 ≤ m.len().
+#[inline(always)]
+unsafe fn neighbours<const D: usize, const K: usize>(
+    m: &Mechanics<D, K>,
+    i0: usize,
+    k: usize,
+) -> [usize; LANES] {
+    let mut j = [0usize; LANES];
+    for (l, j) in j.iter_mut().enumerate() {
+        let jj = *m.neighbours.get_unchecked(i0 + l).get_unchecked(k);
+        *j = if jj != NONE { jj as usize } else { i0 + l };
+    }
+    j
+}
+
+/// `super::particle_force` of particles i0..i0+4, one per lane: the internal force per
+/// component and the bond dampers' power, from the slot cache. Slots with d = 0 (empty or
+/// broken) leave the sums untouched, as the scalar path skips them.
+///
+/// # Safety
+/// AVX available; i0 + 4 ≤ m.len(); x, v and b_theta have m.len() entries; every occupied
+/// slot indexes a particle; pass 1 filled the slot cache at positions x.
+#[target_feature(enable = "avx")]
+#[inline]
+unsafe fn force_block<const D: usize, const K: usize, L: DamageLaw<D, K>, const DAMP: bool>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    r: &StateReads<'_, D>,
+    i0: usize,
+) -> ([__m256d; D], __m256d)
+where
+    Dim<D>: Dimension<D>,
+{
+    let zero = _mm256_setzero_pd();
+    let half = _mm256_set1_pd(0.5);
+    let xi = load_own(r.x, i0);
+    let vi = if DAMP { load_own(r.v, i0) } else { [zero; D] };
+    let bti = _mm256_loadu_pd(r.b_theta.as_ptr().add(i0));
+    let ci = if DAMP {
+        _mm256_loadu_pd(m.c_in.as_ptr().add(i0))
+    } else {
+        zero
+    };
+    let blk = c.cache.as_ptr().add(slot_cache_at(i0, 0, K));
+    let mut f = [zero; D];
+    let mut power = zero;
+    for k in 0..block_slots(m, i0) {
+        let p = blk.add(FIELDS * LANES * k);
+        let d = _mm256_loadu_pd(p.add(3 * LANES));
+        let live = _mm256_cmp_pd::<_CMP_NEQ_UQ>(d, zero);
+        if _mm256_movemask_pd(live) == 0 {
+            continue;
+        }
+        let rinv = _mm256_loadu_pd(p);
+        let d_a_se = _mm256_loadu_pd(p.add(LANES));
+        let sd = _mm256_loadu_pd(p.add(2 * LANES));
+        let j = neighbours(m, i0, k);
+        let xj = gather_vec(r.x, &j);
+        // e = (x_j − x_i)·(1/len)
+        let mut e = [zero; D];
+        for cc in 0..D {
+            e[cc] = _mm256_mul_pd(_mm256_sub_pd(xj[cc], xi[cc]), rinv);
+        }
+        // damaged_bond_force: ½(d·(a_i + a_j)·S_e + √d·(bθ_i + bθ_j))
+        let btj = gather(r.b_theta, &j);
+        let mut fb = _mm256_mul_pd(
+            half,
+            _mm256_add_pd(d_a_se, _mm256_mul_pd(sd, _mm256_add_pd(bti, btj))),
+        );
+        if DAMP {
+            // c_b = d·½·(c_i + c_j), rate = (v_j − v_i)·e
+            let cj = gather(&m.c_in, &j);
+            let cb = _mm256_mul_pd(_mm256_mul_pd(d, half), _mm256_add_pd(ci, cj));
+            let vj = gather_vec(r.v, &j);
+            let mut rate = _mm256_mul_pd(_mm256_sub_pd(vj[0], vi[0]), e[0]);
+            for cc in 1..D {
+                rate = _mm256_add_pd(rate, _mm256_mul_pd(_mm256_sub_pd(vj[cc], vi[cc]), e[cc]));
+            }
+            fb = _mm256_add_pd(fb, _mm256_mul_pd(cb, rate));
+            // power += ½·c_b·rate·rate
+            let pw = _mm256_add_pd(
+                power,
+                _mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(half, cb), rate), rate),
+            );
+            power = _mm256_blendv_pd(power, pw, live);
+        }
+        for cc in 0..D {
+            let fc = _mm256_add_pd(f[cc], _mm256_mul_pd(e[cc], fb));
+            f[cc] = _mm256_blendv_pd(f[cc], fc, live);
+        }
+    }
+    (f, power)
+}
+
+/// Pass 2 over whole blocks of four: the forces (`force_block`) and the central-difference
+/// update (`kernel::avx::update_block`) of particles base.. into `out`, a multiple of four
+/// of them.
+///
+/// # Safety
+/// AVX available; `kernel::avx::vector_update::<D>()`; base + out.xn.len() ≤ m.len() and
+/// every array of `r` has m.len() entries; every occupied slot indexes a particle; pass 1
+/// filled the slot cache at positions r.x.
+#[target_feature(enable = "avx")]
+pub(super) unsafe fn update_chunk<
+    const D: usize,
+    const K: usize,
+    L: DamageLaw<D, K>,
+    const LAG: bool,
+    const DAMP: bool,
+>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    r: &StateReads<'_, D>,
+    dt: f64,
+    base: usize,
+    out: ChunkOut<'_, D>,
+) where
+    Dim<D>: Dimension<D>,
+{
+    let ChunkOut { xn, vn, fo, dw } = out;
+    for o0 in (0..xn.len()).step_by(LANES) {
+        let i0 = base + o0;
+        let (f, power) = force_block::<D, K, L, DAMP>(m, c, r, i0);
+        update_block::<D, K, LAG, DAMP>(
+            m,
+            r.x,
+            r.v,
+            r.force_prev,
+            dt,
+            i0,
+            o0,
+            &f,
+            power,
+            xn,
+            vn,
+            fo,
+            dw,
+        );
     }
 }
