@@ -85,8 +85,8 @@ where
     /// Criteria strain averaged over each particle's neighbourhood (random particles), see
     /// [`Neighbourhood`]; `None`: each particle's own.
     pub neighbourhood: Option<Neighbourhood<D>>,
-    /// Let pass 1 run its SIMD blocks where it can (`true`; `false` for tests that compare
-    /// them with the scalar path).
+    /// Let both passes run their SIMD blocks where they can (`true`; `false` for tests that
+    /// compare them with the scalar path).
     pub simd: bool,
 }
 
@@ -220,7 +220,7 @@ where
 /// it: 32 bytes a slot instead of 40. The cache is laid out in blocks of [`LANES`] particles,
 /// each field of a slot four lanes wide ([`slot_cache_at`]), so that the AVX passes load and
 /// store it a vector at a time (benchmarks/RESULTS.md, "Sixth attempt").
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct SlotCache {
     inv_len: f64,
     d_a_se: f64,
@@ -695,31 +695,17 @@ pub fn step<
     #[cfg(not(target_arch = "x86_64"))]
     let avx = false;
     let cr = &*c;
-    update_in_chunks(st, m.len(), |base, r, out| {
-        let ChunkOut { xn, vn, fo, dw } = out;
-        let len = xn.len();
+    update_in_chunks(st, m.len(), |base, r, mut out| {
+        let len = out.xn.len();
         let done = if avx { len / LANES * LANES } else { 0 };
         #[cfg(target_arch = "x86_64")]
         if done > 0 {
             // SAFETY: AVX is available and D = 2 with 16-byte vectors (checked above);
             // base + len ≤ m.len() and every state array has m.len() entries
             // (update_in_chunks asserts it); pass 1 filled the slot cache of every particle.
-            unsafe {
-                avx::update_chunk::<D, K, L, LAG, DAMP>(
-                    m,
-                    cr,
-                    &r,
-                    dt,
-                    base,
-                    ChunkOut {
-                        xn: &mut xn[..done],
-                        vn: &mut vn[..done],
-                        fo: &mut fo[..done],
-                        dw: &mut dw[..done],
-                    },
-                )
-            }
+            unsafe { avx::update_chunk::<D, K, L, LAG, DAMP>(m, cr, &r, dt, base, out.head(done)) }
         }
+        let ChunkOut { xn, vn, fo, dw } = out;
         for o in done..len {
             let i = base + o;
             let (f, bond_power) = particle_force::<D, K, L, DAMP>(m, cr, r.x, r.v, r.b_theta, i);

@@ -268,11 +268,12 @@ fn update_chunk<
         cache,
         dt,
     } = inp;
-    let ChunkOut { xn, vn, fo, dw } = out;
-    let len = dw.len();
+    let mut out = out;
+    let len = out.dw.len();
     let n = x.len();
     assert!(base + len <= n && csr.len() == n && v.len() == n && b_theta.len() == n);
-    assert!(force_prev.len() == n && xn.len() == len && vn.len() == len && fo.len() == len);
+    assert!(force_prev.len() == n && out.xn.len() == len);
+    assert!(out.vn.len() == len && out.fo.len() == len);
     assert!(!CACHE || cache.len() == bond_cache_len(csr));
     #[cfg(target_arch = "x86_64")]
     let done = if avx {
@@ -280,18 +281,7 @@ fn update_chunk<
         // SAFETY: AVX is available (`use_avx`); base + done ≤ n, every state array has n
         // entries and the model too (`check_sizes`), the cache its full length (asserted
         // above); a Csr's neighbours index its particles.
-        unsafe {
-            avx::update_chunk::<D, K, LAG, DAMP, CACHE>(
-                inp,
-                base,
-                ChunkOut {
-                    xn: &mut xn[..done],
-                    vn: &mut vn[..done],
-                    fo: &mut fo[..done],
-                    dw: &mut dw[..done],
-                },
-            )
-        };
+        unsafe { avx::update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out.head(done)) };
         done
     } else {
         0
@@ -301,6 +291,7 @@ fn update_chunk<
         let _ = avx;
         0
     };
+    let ChunkOut { xn, vn, fo, dw } = out;
     for o in done..len {
         let i = base + o;
         let (f, power) = particle_force::<D, K, DAMP, CACHE>(csr, m, x, v, b_theta, cache, i);

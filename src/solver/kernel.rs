@@ -316,6 +316,18 @@ pub(crate) struct ChunkOut<'b, const D: usize> {
     pub dw: &'b mut [f64],
 }
 
+impl<const D: usize> ChunkOut<'_, D> {
+    /// The chunk's first `len` particles (the share of the AVX blocks).
+    pub fn head(&mut self, len: usize) -> ChunkOut<'_, D> {
+        ChunkOut {
+            xn: &mut self.xn[..len],
+            vn: &mut self.vn[..len],
+            fo: &mut self.fo[..len],
+            dw: &mut self.dw[..len],
+        }
+    }
+}
+
 /// The central-difference update of particle i given its internal force.
 #[inline(always)]
 fn update_one<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
@@ -392,12 +404,12 @@ fn update_chunk<
         cache,
         ..
     } = inp;
-    let ChunkOut { xn, vn, fo, dw } = out;
-    let len = xn.len();
+    let mut out = out;
+    let len = out.xn.len();
     let n = m.len();
     assert!(base + len <= n && x.len() == n && v.len() == n && b_theta.len() == n);
     assert!(force_prev.len() == n);
-    assert!(vn.len() == len && fo.len() == len && dw.len() == len);
+    assert!(out.vn.len() == len && out.fo.len() == len && out.dw.len() == len);
     assert!(!CACHE || cache.len() == bond_cache_len(n, K));
     #[cfg(target_arch = "x86_64")]
     let done = if avx {
@@ -405,18 +417,7 @@ fn update_chunk<
         // SAFETY: AVX is available (`use_avx`); base + done ≤ n and every state array has n
         // entries, the cache its full length (asserted above); Mechanics::new checks every
         // occupied slot indexes a particle.
-        unsafe {
-            avx::update_chunk::<D, K, LAG, DAMP, CACHE>(
-                inp,
-                base,
-                ChunkOut {
-                    xn: &mut xn[..done],
-                    vn: &mut vn[..done],
-                    fo: &mut fo[..done],
-                    dw: &mut dw[..done],
-                },
-            )
-        };
+        unsafe { avx::update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out.head(done)) };
         done
     } else {
         0
@@ -426,6 +427,7 @@ fn update_chunk<
         let _ = (avx, cache);
         0
     };
+    let ChunkOut { xn, vn, fo, dw } = out;
     for o in done..len {
         let i = base + o;
         let (f, bond_power) = particle_force::<D, K, DAMP>(m, x, v, b_theta, i);

@@ -236,24 +236,6 @@ pub(super) unsafe fn slot_block<
     }
 }
 
-/// Neighbours in slot k of particles i0..i0+4 (the particle itself where the slot is empty).
-///
-/// # Safety
-/// i0 + 4 ≤ m.len().
-#[inline(always)]
-unsafe fn neighbours<const D: usize, const K: usize>(
-    m: &Mechanics<D, K>,
-    i0: usize,
-    k: usize,
-) -> [usize; LANES] {
-    let mut j = [0usize; LANES];
-    for (l, j) in j.iter_mut().enumerate() {
-        let jj = *m.neighbours.get_unchecked(i0 + l).get_unchecked(k);
-        *j = if jj != NONE { jj as usize } else { i0 + l };
-    }
-    j
-}
-
 /// `super::particle_force` of particles i0..i0+4, one per lane: the internal force per
 /// component and the bond dampers' power, from the slot cache. Slots with d = 0 (empty or
 /// broken) leave the sums untouched, as the scalar path skips them.
@@ -295,7 +277,9 @@ where
         let rinv = _mm256_loadu_pd(p);
         let d_a_se = _mm256_loadu_pd(p.add(LANES));
         let sd = _mm256_loadu_pd(p.add(2 * LANES));
-        let j = neighbours(m, i0, k);
+        // the neighbours (the particle itself in an empty slot, where d = 0); the slot's
+        // 1/L0, which pass 2 does not need, is left unused
+        let (j, _, _) = slot(m, i0, k);
         let xj = gather_vec(r.x, &j);
         // e = (x_j − x_i)·(1/len)
         let mut e = [zero; D];
