@@ -10,7 +10,7 @@
 //! below (checked by `tests/layering.rs`, which also finds no import circle between the
 //! files of a module):
 //!
-//! 0. tools: [`console`], [`fsio`], [`limits`], [`geometry`], [`random_field`];
+//! 0. tools: [`aligned`], [`console`], [`fsio`], [`limits`], [`geometry`], [`random_field`];
 //! 1. [`scene`]: describes and validates a specimen; it imports nothing from the model, the
 //!    material or the solver;
 //! 2. [`discretise`] fills a body (positions, volumes, horizons, length scales, micro-moduli,
@@ -24,6 +24,7 @@
 //! 6. [`output`]: the reports of an outcome;
 //! 7. [`study`] and [`bench`]: many runs.
 
+pub mod aligned;
 pub mod bench;
 pub mod console;
 pub mod discretise;

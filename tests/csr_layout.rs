@@ -132,7 +132,7 @@ fn compare<const LAG: bool, const DAMP: bool>(steps: usize) {
     let moved = slots
         .x
         .iter()
-        .zip(&st0.x)
+        .zip(st0.x.iter())
         .map(|(a, b)| (a - b).norm())
         .fold(0.0, f64::max);
     assert!(moved > 1e-3 * p.spacing, "moved {moved}");

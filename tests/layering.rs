@@ -1,7 +1,7 @@
 //! The crate's layers run one way (issue 12): no module imports from a module above it, and
 //! no files within a module import each other in a circle. The layers, bottom to top:
 //!
-//! 0. `console`, `fsio`, `limits`, `geometry`, `random_field`: plain tools;
+//! 0. `aligned`, `console`, `fsio`, `limits`, `geometry`, `random_field`: plain tools;
 //! 1. `scene`: describes and validates a specimen;
 //! 2. `discretise` (the body) and `model` (the constitutive law), independent of each other;
 //! 3. `material`: per-particle properties, random fields sampled on a body;
@@ -18,6 +18,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 const LAYERS: &[(&str, u32)] = &[
+    ("aligned", 0),
     ("console", 0),
     ("fsio", 0),
     ("limits", 0),

@@ -41,6 +41,7 @@
 use super::kernel::{central_difference, chunk_len, update_in_chunks, use_avx, ChunkOut, LANES};
 use super::mechanics::{weighted, Mechanics};
 use super::KernelSet;
+use crate::aligned::{filled, Aligned};
 use crate::discretise::{Particles, NONE};
 pub use crate::model::damage_law::ParticleDamage;
 use crate::model::damage_law::{DamageLaw, Kernel, ParticleBonds};
@@ -71,14 +72,14 @@ where
     /// Each particle's length scale L0,i (m; the body's `length`).
     pub length: Vec<f64>,
     /// Committed law state (read by both passes of a step).
-    pub committed: Vec<L::State>,
-    trial: Vec<L::State>,
+    pub committed: Aligned<L::State>,
+    trial: Aligned<L::State>,
     /// Committed plastic stretch states S_Ps,ij (3.48), per slot.
-    pub sps: Vec<[f64; K]>,
-    sps_trial: Vec<[f64; K]>,
+    pub sps: Aligned<[f64; K]>,
+    sps_trial: Aligned<[f64; K]>,
     /// Scratch from pass 1 for pass 2 of the same step, in blocks of [`LANES`] particles
     /// (see [`slot_cache_at`]).
-    cache: Vec<f64>,
+    cache: Aligned<f64>,
     /// Run the full kernel even where the law needs only the tension kernel (for tests that
     /// compare the two).
     pub force_full: bool,
@@ -165,11 +166,11 @@ where
             fit,
             reverse: p.reverse.clone(),
             length: p.length.clone(),
-            committed: vec![L::State::default(); n],
-            trial: vec![L::State::default(); n],
-            sps: vec![[0.0; K]; n],
-            sps_trial: vec![[0.0; K]; n],
-            cache: vec![0.0; slot_cache_len(n, K)],
+            committed: filled(L::State::default(), n),
+            trial: filled(L::State::default(), n),
+            sps: filled([0.0; K], n),
+            sps_trial: filled([0.0; K], n),
+            cache: filled(0.0, slot_cache_len(n, K)),
             force_full: false,
             neighbourhood: None,
             simd: true,
@@ -584,9 +585,9 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
     Dim<D>: Dimension<D>,
 {
     let avx = L::SERIES_DAMAGE && c.simd && use_avx();
-    let mut trial = std::mem::take(&mut c.trial);
-    let mut sps_trial = std::mem::take(&mut c.sps_trial);
-    let mut cache = std::mem::take(&mut c.cache);
+    let mut trial = std::mem::replace(&mut c.trial, Aligned::new(0));
+    let mut sps_trial = std::mem::replace(&mut c.sps_trial, Aligned::new(0));
+    let mut cache = std::mem::replace(&mut c.cache, Aligned::new(0));
     let mut strain_trial = c
         .neighbourhood
         .as_mut()
@@ -1002,7 +1003,7 @@ mod tests {
         let bits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
         let state = |c: &Concrete<2, K>| {
             let mut v = Vec::new();
-            for s in &c.trial {
+            for s in c.trial.iter() {
                 v.extend([
                     s.wt,
                     s.wc,
@@ -1012,7 +1013,7 @@ mod tests {
                 ]);
             }
             v.extend(c.sps_trial.iter().flatten());
-            v.extend(&c.cache);
+            v.extend(c.cache.iter());
             if let Some(nb) = &c.neighbourhood {
                 v.extend(nb.strain_trial.iter().flat_map(|e| e.iter().copied()));
             }
@@ -1033,7 +1034,7 @@ mod tests {
         assert!(want
             .trial
             .iter()
-            .zip(&c.committed)
+            .zip(c.committed.iter())
             .any(|(t, s)| t.initiated && !s.initiated));
         assert!(!FULL || want.trial.iter().filter(|s| s.yielded).count() > n / 20);
         for simd in [true, false] {
@@ -1060,7 +1061,7 @@ mod tests {
         // whole steps (both passes, the law's commits) through the SIMD and the scalar paths
         let mut st = crate::solver::kernel::State::at_rest(&p.x0);
         let mut r = Lcg(17);
-        st.x.clone_from(&x);
+        st.x.copy_from_slice(&x);
         for (v, f) in st.v.iter_mut().zip(st.force_prev.iter_mut()) {
             *v = Vector2::new(r.next() - 0.5, r.next() - 0.5) * 1e-2;
             *f = Vector2::new(r.next() - 0.5, r.next() - 0.5) * 1e3;
@@ -1090,10 +1091,10 @@ mod tests {
             v.extend(
                 st.damping_work
                     .iter()
-                    .chain(&st.b_theta)
+                    .chain(st.b_theta.iter())
                     .map(|c| c.to_bits()),
             );
-            for s in &c.committed {
+            for s in c.committed.iter() {
                 v.extend([s.wt, s.wc, s.eps_init].map(f64::to_bits));
             }
             v

@@ -58,8 +58,9 @@ pub fn bond_cache_len(csr: &Csr) -> usize {
 /// and 1/L0 (8) and writes the cache (16). Pass 2 reads the offset (4), x_i and v_i (16d),
 /// a_i, bθ_i, c_in,i, c_ex,i and 1/m_i (40), writes x, v and F (24d) and reads and writes the
 /// damper work (16); per bond it reads j (4) and the cache (16), not 1/L0. In 2D with six
-/// bonds: 36 + 168 + 140 + 120 = 464 B (the slot kernel, counted alike: 508 B, as it reads
-/// its 6 neighbour and 1/L0 slots in both passes).
+/// bonds: 36 + 168 + 140 + 120 = 464 B. The slot kernel, counted alike, reads its 6 neighbour
+/// slots in both passes: 412 B on a lattice, whose 1/L0 per slot is one value
+/// (`Mechanics::slot_inv_l0`), 460 B where pass 1 reads each particle's 1/L0 row.
 pub const fn bytes_per_particle_step(d: usize, bonds: usize) -> usize {
     (4 + 8 * d + 8 + 8) + bonds * (4 + 8 + 16) + (4 + 16 * d + 40 + 24 * d + 16) + bonds * (4 + 16)
 }
@@ -362,7 +363,7 @@ pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     assert!(st.b_theta.len() == n);
     let len = bond_cache_len(csr);
     if st.bond_cache.len() != len {
-        st.bond_cache = vec![0.0; len];
+        st.bond_cache = crate::aligned::filled(0.0, len);
     }
     let avx = use_avx();
     let chunk = chunk_len(n);
@@ -670,6 +671,7 @@ mod avx {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::aligned::{filled, CollectAligned};
     use crate::solver::kernel::CHUNK;
 
     use crate::solver::test_rng::Lcg;
@@ -694,22 +696,23 @@ mod tests {
         let csr = Csr::from_pairs(&x0, &pairs).unwrap();
         let most = (0..n).map(|i| csr.bond_count(i)).max().unwrap();
         assert!(most >= 10 && csr.bond_count(0) == 0, "{most}");
-        let mut v = |s: f64| (0..n).map(|_| s * (1.0 + r.next())).collect::<Vec<f64>>();
+        let mut v = |s: f64| (0..n).map(|_| s * (1.0 + r.next())).collect_aligned();
         let (a, b, mass, c_in, mut c_ex) = (v(3e6), v(-1e5), v(1e-3), v(10.0), v(1.0));
         for c in c_ex.iter_mut().step_by(3) {
             *c = 0.0;
         }
         let mech = Mechanics {
-            neighbours: vec![[]; n],
-            inv_l0: vec![[]; n],
+            neighbours: filled([], n),
+            inv_l0: filled([], n),
+            slot_inv_l0: None,
             a,
             b,
-            inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
+            inv_mass: mass.iter().map(|m| 1.0 / m).collect_aligned(),
             mass,
             c_in,
             c_ex,
             dilatation_weight: None,
-            slot_end: vec![0; n],
+            slot_end: filled(0, n),
         };
         let mut st = State::at_rest(&x0);
         for i in 0..n {

@@ -20,6 +20,7 @@
 //! step's positions drives this step.
 
 use super::mechanics::{weighted, Mechanics};
+use crate::aligned::{copied, filled, Aligned};
 use crate::model::force_state::{bond_force, dilatation_term};
 use crate::model::stretch::total_stretch;
 use nalgebra::SVector;
@@ -40,40 +41,40 @@ pub fn chunk_len(n: usize) -> usize {
 #[derive(Clone, Debug)]
 pub struct State<const D: usize> {
     /// Positions x^n.
-    pub x: Vec<SVector<f64, D>>,
+    pub x: Aligned<SVector<f64, D>>,
     /// Velocities v^{n−½}.
-    pub v: Vec<SVector<f64, D>>,
-    pub x_next: Vec<SVector<f64, D>>,
-    pub v_next: Vec<SVector<f64, D>>,
+    pub v: Aligned<SVector<f64, D>>,
+    pub x_next: Aligned<SVector<f64, D>>,
+    pub v_next: Aligned<SVector<f64, D>>,
     /// Internal force (bonds and bond dampers) at x^n.
-    pub force: Vec<SVector<f64, D>>,
+    pub force: Aligned<SVector<f64, D>>,
     /// Internal force at x^{n−1} (reading A only).
-    pub force_prev: Vec<SVector<f64, D>>,
+    pub force_prev: Aligned<SVector<f64, D>>,
     /// b_i·θ_i of the current step.
-    pub b_theta: Vec<f64>,
+    pub b_theta: Aligned<f64>,
     /// Work done on each particle's dampers so far (J).
-    pub damping_work: Vec<f64>,
+    pub damping_work: Aligned<f64>,
     /// Per-slot stretch S and 1/|x_j − x_i| (0 in empty slots) from pass 1 of the current
     /// [`step`], reused by pass 2; laid out in blocks of [`LANES`] particles (see
     /// [`bond_cache_len`]). Scratch: it carries nothing from one step to the next.
-    pub bond_cache: Vec<f64>,
+    pub bond_cache: Aligned<f64>,
 }
 
 impl<const D: usize> State<D> {
     /// At rest in the reference configuration.
     pub fn at_rest(x0: &[SVector<f64, D>]) -> Self {
         let n = x0.len();
-        let z = vec![SVector::zeros(); n];
+        let z = filled(SVector::zeros(), n);
         State {
-            x: x0.to_vec(),
+            x: copied(x0),
             v: z.clone(),
-            x_next: x0.to_vec(),
+            x_next: copied(x0),
             v_next: z.clone(),
             force: z.clone(),
             force_prev: z,
-            b_theta: vec![0.0; n],
-            damping_work: vec![0.0; n],
-            bond_cache: vec![0.0; bond_cache_len(n, crate::discretise::slots(D))],
+            b_theta: filled(0.0, n),
+            damping_work: filled(0.0, n),
+            bond_cache: filled(0.0, bond_cache_len(n, crate::discretise::slots(D))),
         }
     }
 }
@@ -547,7 +548,7 @@ pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     let len = bond_cache_len(m.len(), K);
     if st.bond_cache.len() != len {
         // Only where the state was made for another slot count (see State::at_rest).
-        st.bond_cache = vec![0.0; len];
+        st.bond_cache = filled(0.0, len);
     }
     pass_dilatation_cached(m, &st.x, &mut st.b_theta, &mut st.bond_cache);
     pass_update_impl::<D, K, LAG, DAMP, true>(m, st, dt);
@@ -665,16 +666,23 @@ pub(crate) mod avx {
     ) -> ([usize; 4], __m256d, __m256d) {
         let mut j = [0usize; 4];
         let mut occ = [0i64; 4];
-        let mut il = [0.0; 4];
         for l in 0..4 {
             let jj = *m.neighbours.get_unchecked(i0 + l).get_unchecked(k);
             let o = jj != NONE;
             occ[l] = -(o as i64);
             j[l] = if o { jj as usize } else { i0 + l };
-            il[l] = *m.inv_l0.get_unchecked(i0 + l).get_unchecked(k);
         }
         let mask = _mm256_castsi256_pd(_mm256_set_epi64x(occ[3], occ[2], occ[1], occ[0]));
-        (j, mask, _mm256_loadu_pd(il.as_ptr()))
+        // 1/L0: the slot's one value on a lattice (an empty lane's value is masked by the
+        // caller), else each particle's own
+        let il = match &m.slot_inv_l0 {
+            Some(u) => _mm256_set1_pd(*u.get_unchecked(k)),
+            None => {
+                let r = |l: usize| *m.inv_l0.get_unchecked(i0 + l).get_unchecked(k);
+                _mm256_set_pd(r(3), r(2), r(1), r(0))
+            }
+        };
+        (j, mask, il)
     }
 
     /// d = x_j − x_i per component and |d| (components summed in order, as nalgebra does).
@@ -1034,7 +1042,9 @@ pub(crate) mod avx {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::aligned::CollectAligned;
     use crate::discretise::NONE;
+    use crate::solver::mechanics::uniform_inv_l0;
 
     use crate::solver::test_rng::Lcg;
 
@@ -1059,7 +1069,7 @@ mod tests {
                 }
             }
         }
-        let mut v = |s: f64| (0..n).map(|_| s * (1.0 + r.next())).collect::<Vec<f64>>();
+        let mut v = |s: f64| (0..n).map(|_| s * (1.0 + r.next())).collect_aligned();
         let (a, b, mass, c_in, mut c_ex) = (v(3e6), v(-1e5), v(1e-3), v(10.0), v(1.0));
         // some particles without a particle damper (h = 0)
         for c in c_ex.iter_mut().step_by(3) {
@@ -1067,11 +1077,12 @@ mod tests {
         }
         let slot_end = crate::solver::mechanics::slot_end(&neighbours);
         let mech = Mechanics {
-            neighbours,
-            inv_l0,
+            neighbours: copied(&neighbours),
+            slot_inv_l0: uniform_inv_l0(&neighbours, &inv_l0),
+            inv_l0: copied(&inv_l0),
             a,
             b,
-            inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
+            inv_mass: mass.iter().map(|m| 1.0 / m).collect_aligned(),
             mass,
             c_in,
             c_ex,
@@ -1087,17 +1098,35 @@ mod tests {
         (mech, st)
     }
 
-    /// The kernel against the plain per-particle code, bit for bit, on 1 and 2 threads.
+    /// The kernel against the plain per-particle code, bit for bit, on 1 and 2 threads, with
+    /// a reference length per bond and with one per slot (a lattice: the AVX blocks
+    /// broadcast [`Mechanics::slot_inv_l0`]).
     fn check<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>() {
-        check_weighted::<D, K, LAG, DAMP>(false);
+        check_weighted::<D, K, LAG, DAMP>(false, false);
+        check_weighted::<D, K, LAG, DAMP>(false, true);
     }
 
-    /// [`check`]; with `weighted`, the body weighs its dilatations (random particles).
+    /// [`check`]; with `weighted`, the body weighs its dilatations (random particles); with
+    /// `per_slot`, every bond in slot k has the same reference length.
     fn check_weighted<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
         weighted: bool,
+        per_slot: bool,
     ) {
         let n = 2 * CHUNK + 4 * 37 + 3;
         let (mut m, st0) = model::<D, K>(n);
+        assert!(m.slot_inv_l0.is_none());
+        if per_slot {
+            let u: [f64; K] = std::array::from_fn(|k| 1.0 / (3e-3 * (1.0 + 0.1 * k as f64)));
+            for (s, l) in m.neighbours.iter().zip(m.inv_l0.iter_mut()) {
+                for k in 0..K {
+                    if s[k] != NONE {
+                        l[k] = u[k];
+                    }
+                }
+            }
+            m.slot_inv_l0 = uniform_inv_l0(&m.neighbours, &m.inv_l0);
+            assert_eq!(m.slot_inv_l0, Some(u));
+        }
         if weighted {
             // L0,ik/ℓ_i of random particles lies about 0.6–1.6
             let mut r = Lcg(7);
@@ -1113,7 +1142,7 @@ mod tests {
                             }
                         })
                     })
-                    .collect(),
+                    .collect_aligned(),
             );
         }
         let dt = 1e-7;
@@ -1178,7 +1207,7 @@ mod tests {
         check::<3, 18, false, true>();
         check::<3, 18, true, false>();
         // weighted dilatation (random particles) on the AVX and scalar paths
-        check_weighted::<2, 12, false, true>(true);
-        check_weighted::<2, 12, true, false>(true);
+        check_weighted::<2, 12, false, true>(true, false);
+        check_weighted::<2, 12, true, false>(true, false);
     }
 }

@@ -1,32 +1,59 @@
 //! Per-particle static data of the step kernel, in structure-of-arrays form, allocated once:
 //! neighbour slots, 1/L0 per slot, micro-moduli, masses and damper coefficients.
 
+use crate::aligned::{copied, filled, Aligned, CollectAligned};
 use crate::discretise::{Particles, NONE};
 use crate::model::force_state::axial_stiffness;
 use nalgebra::SVector;
 
 /// The assembled SPLM model of one run.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Mechanics<const D: usize, const K: usize> {
-    pub neighbours: Vec<[u32; K]>,
-    pub inv_l0: Vec<[f64; K]>,
+    pub neighbours: Aligned<[u32; K]>,
+    pub inv_l0: Aligned<[f64; K]>,
+    /// 1/L0 of slot k where every particle with that slot occupied has the same bits there
+    /// (the lattices: one spacing, or FCC's two); `None` otherwise (random particles). The
+    /// AVX blocks broadcast it instead of loading slot k from four rows of `inv_l0`, which
+    /// saves 8·K bytes a particle-step (benchmarks/RESULTS.md, "Aligned arrays and uniform
+    /// reference lengths"). Derived from `inv_l0` by [`uniform_inv_l0`]: recompute it after
+    /// changing `inv_l0` or `neighbours`.
+    pub slot_inv_l0: Option<[f64; K]>,
     /// Micro-modulus a_i (N).
-    pub a: Vec<f64>,
+    pub a: Aligned<f64>,
     /// Micro-modulus b_i (N).
-    pub b: Vec<f64>,
-    pub mass: Vec<f64>,
-    pub inv_mass: Vec<f64>,
+    pub b: Aligned<f64>,
+    pub mass: Aligned<f64>,
+    pub inv_mass: Aligned<f64>,
     /// Bond damper coefficient C_in,i = 2·m_i·ξ_in·ω_i (3.55); a bond uses ½(C_in,i + C_in,j)
     /// so that Newton's third law holds for unequal particles.
-    pub c_in: Vec<f64>,
+    pub c_in: Aligned<f64>,
     /// Particle damper coefficient C_ex,i = 2·m_i·ξ_ex·ω_struct (3.56).
-    pub c_ex: Vec<f64>,
+    pub c_ex: Aligned<f64>,
     /// Per-slot weight L0,ik/ℓ_i of the dilatation θ_i = Σ_k w_ik·S_ik where the body asks
     /// for it (random particles, [`Particles::weighted_dilatation`]); `None`: θ_i = Σ_k S_ik.
-    pub dilatation_weight: Option<Vec<[f64; K]>>,
+    pub dilatation_weight: Option<Aligned<[f64; K]>>,
     /// One past each particle's last occupied slot: the AVX blocks stop at the largest of
     /// their four (random particles fill 6–11 of 12 slots).
-    pub slot_end: Vec<u8>,
+    pub slot_end: Aligned<u8>,
+}
+
+impl<const D: usize, const K: usize> Default for Mechanics<D, K> {
+    /// No particles.
+    fn default() -> Self {
+        Mechanics {
+            neighbours: Aligned::new(0),
+            inv_l0: Aligned::new(0),
+            slot_inv_l0: None,
+            a: Aligned::new(0),
+            b: Aligned::new(0),
+            mass: Aligned::new(0),
+            inv_mass: Aligned::new(0),
+            c_in: Aligned::new(0),
+            c_ex: Aligned::new(0),
+            dilatation_weight: None,
+            slot_end: Aligned::new(0),
+        }
+    }
 }
 
 /// w_k·s for a row of [`Mechanics::weights`]; s itself without weights, so that the lattices
@@ -39,12 +66,35 @@ pub fn weighted<const K: usize>(w: Option<&[f64; K]>, k: usize, s: f64) -> f64 {
     }
 }
 
+/// 1/L0 per slot where it is the same, bit for bit, for every particle with that slot
+/// occupied (0 for a slot that no particle occupies); `None` where any slot differs between
+/// two particles. See [`Mechanics::slot_inv_l0`].
+pub fn uniform_inv_l0<const K: usize>(
+    neighbours: &[[u32; K]],
+    inv_l0: &[[f64; K]],
+) -> Option<[f64; K]> {
+    let mut u: [Option<f64>; K] = [None; K];
+    for (s, l) in neighbours.iter().zip(inv_l0) {
+        for k in 0..K {
+            if s[k] == NONE {
+                continue;
+            }
+            match u[k] {
+                None => u[k] = Some(l[k]),
+                Some(v) if v.to_bits() == l[k].to_bits() => {}
+                Some(_) => return None,
+            }
+        }
+    }
+    Some(u.map(|v| v.unwrap_or(0.0)))
+}
+
 /// One past the last occupied slot of each particle.
-pub fn slot_end<const K: usize>(neighbours: &[[u32; K]]) -> Vec<u8> {
+pub fn slot_end<const K: usize>(neighbours: &[[u32; K]]) -> Aligned<u8> {
     neighbours
         .iter()
         .map(|s| s.iter().rposition(|&j| j != NONE).map_or(0, |k| k + 1) as u8)
-        .collect()
+        .collect_aligned()
 }
 
 impl<const D: usize, const K: usize> Mechanics<D, K> {
@@ -70,8 +120,8 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
                     }
                     r
                 })
-                .collect();
-        let mass: Vec<f64> = (0..n).map(|i| rho[i] * p.volume[i]).collect();
+                .collect_aligned();
+        let mass: Aligned<f64> = (0..n).map(|i| rho[i] * p.volume[i]).collect_aligned();
         let dilatation_weight = p.weighted_dilatation.then(|| {
             (0..n)
                 .map(|i| {
@@ -83,17 +133,18 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
                         }
                     })
                 })
-                .collect()
+                .collect_aligned()
         });
         Mechanics {
-            neighbours: p.neighbours.clone(),
+            neighbours: copied(&p.neighbours),
+            slot_inv_l0: uniform_inv_l0(&p.neighbours, &inv_l0),
             inv_l0,
-            a: p.a.clone(),
-            b: p.b.clone(),
-            inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
+            a: copied(&p.a),
+            b: copied(&p.b),
+            inv_mass: mass.iter().map(|m| 1.0 / m).collect_aligned(),
             mass,
-            c_in: vec![0.0; n],
-            c_ex: vec![0.0; n],
+            c_in: filled(0.0, n),
+            c_ex: filled(0.0, n),
             dilatation_weight,
             slot_end: slot_end(&p.neighbours),
         }
