@@ -16,20 +16,22 @@
 //! nothing can break them after construction.
 
 use super::{Particles, NONE};
+use crate::aligned::{copied, Aligned};
 use nalgebra::SVector;
 
 /// The bonds of a body, two directed entries per undirected bond (MODEL.md §1: particle i
-/// sees bond "ij", particle j sees "ji").
+/// sees bond "ij", particle j sees "ji"), in arrays that start on cache lines and ask for
+/// huge pages ([`crate::aligned`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Csr {
     /// Bonds of particle i: flat entries `offsets[i]..offsets[i + 1]` (n + 1 entries).
-    offsets: Vec<u32>,
+    offsets: Aligned<u32>,
     /// Per directed bond ij: the neighbour j.
-    neighbours: Vec<u32>,
+    neighbours: Aligned<u32>,
     /// Per directed bond ij: the flat position of bond ji.
-    reverse: Vec<u32>,
+    reverse: Aligned<u32>,
     /// Per directed bond: 1/L0, with L0 the reference length (MODEL.md §2, (3.10)).
-    inv_l0: Vec<f64>,
+    inv_l0: Aligned<f64>,
 }
 
 impl Csr {
@@ -99,10 +101,10 @@ impl Csr {
             }
         }
         let csr = Csr {
-            offsets,
-            neighbours,
-            reverse,
-            inv_l0,
+            offsets: copied(&offsets),
+            neighbours: copied(&neighbours),
+            reverse: copied(&reverse),
+            inv_l0: copied(&inv_l0),
         };
         csr.check_topology()?;
         Ok(csr)
@@ -171,10 +173,10 @@ impl Csr {
             inv_l0[w as usize] = 1.0 / l0;
         }
         let csr = Csr {
-            offsets,
-            neighbours,
-            reverse,
-            inv_l0,
+            offsets: copied(&offsets),
+            neighbours: copied(&neighbours),
+            reverse: copied(&reverse),
+            inv_l0: copied(&inv_l0),
         };
         debug_assert!(csr.check_topology().is_ok());
         Ok(csr)
