@@ -20,6 +20,7 @@
 pub type Aligned<T> = aligned_vec::AVec<T, aligned_vec::ConstAlign<64>>;
 
 /// Huge-page size on x86-64 Linux; smaller arrays are not advised.
+#[cfg(target_os = "linux")]
 const HUGE: usize = 2 << 20;
 
 /// Room for n elements, not yet touched, advised for huge pages where it is large enough.
