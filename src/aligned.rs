@@ -17,6 +17,8 @@
 //! contents and every result are the same as with `Vec`.
 
 /// A growable array whose first element is on a 64-byte boundary; it dereferences to a slice.
+/// A clone is aligned too but not advised for huge pages: build the kernels' arrays with the
+/// functions below.
 pub type Aligned<T> = aligned_vec::AVec<T, aligned_vec::ConstAlign<64>>;
 
 /// Huge-page size on x86-64 Linux; smaller arrays are not advised.

@@ -38,7 +38,10 @@
 //! (`model::two_spring`) is one implementation. This kernel computes the kinematics, asks the
 //! law for each bond's damage factor and each particle's new state, and moves the particles.
 
-use super::kernel::{central_difference, chunk_len, update_in_chunks, use_avx, ChunkOut, LANES};
+use super::kernel::{
+    central_difference, chunk_len, lane_cache_at, lane_cache_len, update_in_chunks, use_avx,
+    ChunkOut, LANES,
+};
 use super::mechanics::{weighted, Mechanics};
 use super::KernelSet;
 use crate::aligned::{filled, Aligned};
@@ -232,16 +235,16 @@ pub struct SlotCache {
 /// The slot cache's fields per slot.
 const FIELDS: usize = 4;
 
-/// Length of the slot cache of n particles with k slots each.
+/// Length of the slot cache of n particles with k slots each ([`lane_cache_len`]).
 pub(crate) const fn slot_cache_len(n: usize, k: usize) -> usize {
-    n.div_ceil(LANES) * LANES * FIELDS * k
+    lane_cache_len(n, k, FIELDS)
 }
 
 /// Index in the slot cache of the first field (1/length) of slot k of particle i; the fields
 /// d·(a_i + a_j)·S_e, √d and d follow [`LANES`] entries apart each.
 #[inline(always)]
 pub(crate) const fn slot_cache_at(i: usize, k: usize, slots: usize) -> usize {
-    (i / LANES) * (FIELDS * LANES * slots) + FIELDS * LANES * k + i % LANES
+    lane_cache_at(i, k, slots, FIELDS)
 }
 
 impl SlotCache {

@@ -64,14 +64,15 @@ impl<const D: usize> State<D> {
     /// At rest in the reference configuration.
     pub fn at_rest(x0: &[SVector<f64, D>]) -> Self {
         let n = x0.len();
-        let z = filled(SVector::zeros(), n);
+        // each array built on its own: a clone would not be advised for huge pages
+        let z = || filled(SVector::zeros(), n);
         State {
             x: copied(x0),
-            v: z.clone(),
+            v: z(),
             x_next: copied(x0),
-            v_next: z.clone(),
-            force: z.clone(),
-            force_prev: z,
+            v_next: z(),
+            force: z(),
+            force_prev: z(),
             b_theta: filled(0.0, n),
             damping_work: filled(0.0, n),
             bond_cache: filled(0.0, bond_cache_len(n, crate::discretise::slots(D))),
@@ -82,18 +83,33 @@ impl<const D: usize> State<D> {
 /// Particles handled together, one per SIMD lane (see `avx::dilatation_block`).
 pub const LANES: usize = 4;
 
-/// Length of [`State::bond_cache`] for n particles with K slots. Block b (particles
-/// 4b..4b+4) holds, for each slot k, the 4 stretches then the 4 inverse lengths, one per lane
-/// (see [`bond_cache_at`]).
+/// Length of a per-slot cache of n particles with k slots and `fields` values a slot, laid
+/// out in blocks of [`LANES`] particles: block b (particles 4b..4b+4) holds, for each slot,
+/// each field as 4 consecutive values, one per lane, so that an AVX pass loads or stores a
+/// field a vector at a time (see [`lane_cache_at`]). The elastic bond cache and the concrete
+/// slot cache share it.
+pub const fn lane_cache_len(n: usize, k: usize, fields: usize) -> usize {
+    n.div_ceil(LANES) * LANES * fields * k
+}
+
+/// Index of the first field of slot k of particle i in a [`lane_cache_len`] layout with
+/// `slots` slots; field f follows f·LANES entries later.
+#[inline(always)]
+pub const fn lane_cache_at(i: usize, k: usize, slots: usize, fields: usize) -> usize {
+    (i / LANES) * (fields * LANES * slots) + fields * LANES * k + i % LANES
+}
+
+/// Length of [`State::bond_cache`] for n particles with K slots: per slot the stretch, then
+/// the inverse length ([`lane_cache_len`] with two fields).
 pub const fn bond_cache_len(n: usize, k: usize) -> usize {
-    n.div_ceil(LANES) * LANES * 2 * k
+    lane_cache_len(n, k, 2)
 }
 
 /// Index in [`State::bond_cache`] of the stretch in slot k of particle i (its inverse length
 /// follows LANES entries later).
 #[inline(always)]
 pub const fn bond_cache_at(i: usize, k: usize, slots: usize) -> usize {
-    (i / LANES) * (2 * LANES * slots) + 2 * LANES * k + i % LANES
+    lane_cache_at(i, k, slots, 2)
 }
 
 /// b_i·θ_i, θ_i = Σ_m w_im·S_im (w = 1 without weights), for particle i (scalar; chunk tails
