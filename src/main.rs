@@ -287,10 +287,13 @@ fn check<const K: usize>(sc: &Scene, mem: f64, stage: &dyn Fn(&str)) -> anyhow::
             per_step * p.steps as f64
         );
     }
+    let sf = &p.model.surface;
     say!(
-        "surface corr.    {} of {} boundary particles",
-        p.model.surface.corrected,
-        p.model.surface.boundary_particles
+        "surface          {}: {} boundary particles, {} fitted; particles' volume {:+.2e} of the body's",
+        sf.method,
+        sf.boundary_particles,
+        sf.corrected,
+        sf.particle_volume / sf.body_volume - 1.0
     );
     for d in &sc.derived {
         say!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);

@@ -7,7 +7,8 @@
 //! stretches d_ij·S_e,ij, rather than (3.18). For an undamaged bulk particle the two are
 //! identical, and with damage they differ only by the d_ij on the b-term; but (3.18)
 //! under-reads at free surfaces (full ΔV, half the bonds) by up to ~60%, so cracks could
-//! neither start nor run through surface particles. The stress maps show (3.18).
+//! neither start nor run through surface particles. The stress maps show the same D·ε of the
+//! particle's own strain (`run::stress_recovery`).
 
 use super::damage::{self, ConcreteLaw, LocalProperties};
 use super::damage_law::{DamageLaw, Kernel, ParticleBonds, ParticleDamage};

@@ -44,7 +44,7 @@ pub const PARTICLE_COLUMNS: [&str; 7] =
 pub const DAMAGE_COLUMNS: [&str; 3] = ["tensile_damage", "compressive_damage", "yielded"];
 
 /// particles.csv: one row per particle at the end of the run: reference position, displacement,
-/// stress (3.18) and, with damage, w_t, w_c and whether it yielded.
+/// recovered stress (`run::stress_recovery`) and, with damage, w_t, w_c and whether it yielded.
 pub fn write_particles(o: &crate::run::Outcome, path: &Path) -> anyhow::Result<()> {
     let mut w = ::csv::Writer::from_path(path)
         .with_context(|| format!("cannot write {}", path.display()))?;

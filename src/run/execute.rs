@@ -3,7 +3,7 @@
 
 use super::prepare::{prepare_with, slots_of, Prepared};
 use super::summary::{point3, summarise, voigt6, Finished, Outcome, SolverReport};
-use super::{RunError, RunOptions};
+use super::{stress_recovery, RunError, RunOptions};
 use crate::discretise::random;
 use crate::material::properties;
 use crate::model::force_state::{dilatation_term, force_state};
@@ -155,16 +155,12 @@ fn run_prepared<const K: usize>(
         .zip(&p.model.particles.x0)
         .map(|(a, b)| a - b)
         .collect();
-    let (stress, damage) = match &sim.inelastic {
-        Some(model) => (
-            model.particle_stress(&sim.mech, &x, &p.model.particles.volume),
-            Some(model.damage()),
-        ),
-        None => (
-            particle_stress(&sim.mech, &p.model.particles.volume, &x),
-            None,
-        ),
+    // the recovered stress D_i·ε_i (run::stress_recovery), not (3.18)
+    let (strain, damage) = match &sim.inelastic {
+        Some(model) => (model.particle_strain(&sim.mech, &x), Some(model.damage())),
+        None => (stress_recovery::elastic_strain(&p.model, &x), None),
     };
+    let stress = stress_recovery::recovered_stress(&p.model, &strain);
     let summary = summarise(
         &p,
         &Finished {

@@ -3,12 +3,12 @@
 
 use super::RunError;
 use crate::discretise::random::{self, Generation, RandomParticles};
-use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, Particles};
+use crate::discretise::{bytes_per_particle, groups, hex::HexLattice, voronoi, Particles};
 use crate::limits::available_memory;
 use crate::material;
 use crate::material::properties::{self, SampledField};
 use crate::model::micro_modulus::{self, MicroModuli};
-use crate::scene::Scene;
+use crate::scene::{Scene, Surface};
 use crate::solver::loading::Prescribed;
 use crate::solver::mechanics::Mechanics;
 use crate::solver::time_step::{stable_step, StableStep};
@@ -16,18 +16,27 @@ use crate::solver::{modal, Probe};
 use nalgebra::Vector2;
 use serde::Serialize;
 
-/// Statistics of the surface correction (MODEL.md §3).
+/// How the lattice's boundary particles were weighted (`discretisation.surface`; MODEL.md §1,
+/// §3): their count, the fits, and the body's volume against the particles'.
 #[derive(Clone, Debug, Serialize)]
 pub struct SurfaceCorrection {
+    /// `discretisation.surface` ("voronoi_fit", "voronoi", "lattice", "lattice_fit";
+    /// "voronoi_fit" for random particles, which fit every particle).
+    pub method: &'static str,
+    /// Whether boundary particles got fitted micro-moduli.
     pub enabled: bool,
-    /// Particles with fewer than six bonds.
+    /// Particles with fewer than six bonds or a clipped cell.
     pub boundary_particles: usize,
     /// Boundary particles given fitted constants.
     pub corrected: usize,
-    /// Boundary particles whose bonds cannot carry a fit (kept at bulk constants).
+    /// Boundary particles whose bonds cannot carry a fit (kept at bulk constants, scaled by
+    /// their volume fraction under a "voronoi" method).
     pub kept_bulk: usize,
     /// Largest ‖a·A + b·B − D‖/‖D‖ among the corrected particles.
     pub max_residual: f64,
+    /// The body's volume (area × thickness, m³) and the particles' total ΔV.
+    pub body_volume: f64,
+    pub particle_volume: f64,
 }
 
 /// What a random body (SPPM) adds to the model: its Voronoi cells, what generation
@@ -270,8 +279,9 @@ fn assemble<const K: usize>(
         })
         .collect();
 
-    // Micro-moduli, with the surface correction of particles that miss bonds.
+    // Micro-moduli, with the surface treatment of particles that miss bonds.
     stage("micro-moduli and the surface correction");
+    let mut particles = particles;
     // Bulk constants (4.5), (4.6) of each particle's own spacing; reported at the nominal one.
     let bulk = micro_modulus::hexagonal(m.youngs_modulus(), m.nu, d.spacing, m.thickness, m.plane);
     let dmat = micro_modulus::elasticity_matrix(m.youngs_modulus(), m.nu, m.plane);
@@ -288,31 +298,29 @@ fn assemble<const K: usize>(
         .collect();
     let mut a: Vec<f64> = own.iter().map(|mm| mm.a).collect();
     let mut b: Vec<f64> = own.iter().map(|mm| mm.b).collect();
+    let is_random = random_body.is_some();
+    let method = d.surface();
     let mut surface = SurfaceCorrection {
-        enabled: d.surface_correction,
+        method: method.name(),
+        enabled: is_random || matches!(method, Surface::VoronoiFit | Surface::LatticeFit),
         boundary_particles: 0,
         corrected: 0,
         kept_bulk: 0,
         max_residual: 0.0,
+        body_volume: shape.area() * m.thickness,
+        particle_volume: 0.0,
     };
-    let is_random = random_body.is_some();
-    for i in 0..n {
-        if is_random || particles.bond_count(i) == 6 {
-            continue;
-        }
-        surface.boundary_particles += 1;
-        if !d.surface_correction {
-            continue;
-        }
-        match micro_modulus::fit(&particles.reference_bonds(i), particles.volume[i], &dmat) {
-            Some(f) => {
-                a[i] = f.moduli.a;
-                b[i] = f.moduli.b;
-                surface.corrected += 1;
-                surface.max_residual = surface.max_residual.max(f.residual);
-            }
-            None => surface.kept_bulk += 1,
-        }
+    if !is_random {
+        stage("boundary particles: clipped Voronoi cells and fitted moduli");
+        surface_treatment(
+            &mut particles,
+            &shape,
+            method,
+            &dmat,
+            &mut a,
+            &mut b,
+            &mut surface,
+        )?;
     }
     // Random particles: every particle's own least-squares constants (MODEL.md §3, (3.20)).
     let target = match (&random_body, calibrate) {
@@ -356,7 +364,7 @@ fn assemble<const K: usize>(
             b[i] *= f[i];
         }
     }
-    let mut particles = particles;
+    surface.particle_volume = particles.volume.iter().sum();
     particles.a = a;
     particles.b = b;
     let rho = vec![m.rho; n];
@@ -373,6 +381,87 @@ fn assemble<const K: usize>(
         fields,
         random,
     })
+}
+
+/// The boundary treatment of a lattice body (`discretisation.surface`, MODEL.md §1, §3) into
+/// `particles.volume` and the micro-moduli `a`, `b` (which hold each particle's bulk
+/// constants on entry).
+///
+/// - `voronoi_fit`, `voronoi`: each particle's volume is its Voronoi cell clipped to the body
+///   (`discretise::voronoi`), so the particles carry the body's mass at any rotation and
+///   offset. A particle with all six bonds and an unclipped cell keeps the lattice cell
+///   (bit for bit). Any other particle gets, under `voronoi_fit`, the least-squares (a, b) of
+///   its own bonds and clipped volume against D (3.20), which for a particle with six bonds
+///   is exactly the bulk constants times its volume fraction; under `voronoi` (and where a
+///   fit does not exist) the bulk constants times its volume fraction.
+/// - `lattice`: the source's full cells and bulk constants.
+/// - `lattice_fit`: full cells; particles missing bonds get the least-squares fit.
+#[allow(clippy::too_many_arguments)]
+fn surface_treatment<const K: usize>(
+    particles: &mut Particles<2, K>,
+    shape: &crate::geometry::Shape2,
+    method: Surface,
+    dmat: &nalgebra::Matrix3<f64>,
+    a: &mut [f64],
+    b: &mut [f64],
+    report: &mut SurfaceCorrection,
+) -> Result<(), RunError> {
+    let n = particles.len();
+    let thickness = particles.volume[0] / (0.5 * 3f64.sqrt() * particles.spacing.powi(2));
+    let clipped = match method {
+        Surface::VoronoiFit | Surface::Voronoi => Some(
+            voronoi::clipped_cells(&particles.x0, shape).map_err(|e| {
+                RunError::Setup(format!(
+                    "discretisation.surface = \"{}\": the clipped Voronoi cells of the lattice failed: {e}",
+                    method.name()
+                ))
+            })?,
+        ),
+        Surface::Lattice | Surface::LatticeFit => None,
+    };
+    for i in 0..n {
+        let cell = particles.volume[i];
+        let full_bonds = particles.bond_count(i) == 6;
+        let volume = match &clipped {
+            Some(c) => {
+                let v = c[i].1 * thickness;
+                if full_bonds && (v - cell).abs() <= 1e-12 * cell {
+                    cell
+                } else {
+                    v
+                }
+            }
+            None => cell,
+        };
+        if full_bonds && volume == cell {
+            continue;
+        }
+        report.boundary_particles += 1;
+        particles.volume[i] = volume;
+        let fraction = volume / cell;
+        let fit = match method {
+            Surface::VoronoiFit | Surface::LatticeFit => {
+                micro_modulus::fit(&particles.reference_bonds(i), volume, dmat)
+            }
+            Surface::Voronoi | Surface::Lattice => None,
+        };
+        match fit {
+            Some(f) => {
+                a[i] = f.moduli.a;
+                b[i] = f.moduli.b;
+                report.corrected += 1;
+                report.max_residual = report.max_residual.max(f.residual);
+            }
+            None => {
+                a[i] *= fraction;
+                b[i] *= fraction;
+                if report.enabled {
+                    report.kept_bulk += 1;
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Each random particle's least-squares (a_i, b_i) against the elasticity matrix `d` from its

@@ -184,17 +184,58 @@ pub struct DiscretisationSpec {
     /// Lattice offset (m), applied after rotation.
     #[serde(default)]
     pub offset: [f64; 2],
-    /// Per-particle micro-moduli for particles with missing bonds, fitted the SPPM way
-    /// (MODEL.md §3, "surface correction"). Default off: on a plate in tension it makes the
-    /// edges too stiff by about as much as they are too soft without it (E +0.25% on,
-    /// −0.20% off at W/L0 = 100; +1.02% / −0.77% at W/L0 = 25; tests/elastic_plate.rs). On
-    /// peak loads it helps the tension block (0.957 → 1.000 × f't·A) but overshoots the
-    /// split cylinder (+2.3% → +3.8%) and dog-bone B (+0.2% → +3.0%) (benchmarks/RESULTS.md).
+    /// How a lattice treats its boundary particles ([`Surface`]; default
+    /// [`Surface::VoronoiFit`]).
     #[serde(default)]
-    pub surface_correction: bool,
+    pub surface: Option<Surface>,
+    /// Before `surface` existed: `true` is `surface = "lattice_fit"`, `false` is
+    /// `surface = "lattice"` (the behaviour such scenes were written for). Give one or the
+    /// other.
+    #[serde(default)]
+    pub surface_correction: Option<bool>,
+}
+
+/// How a lattice's boundary particles are weighted (`discretisation.surface`; MODEL.md §1,
+/// §3; measured in benchmarks/RESULTS.md, "Surfaces").
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Surface {
+    /// Each particle's volume is its Voronoi cell clipped to the body (the body's mass and
+    /// area at any rotation and offset); a particle whose cell is clipped or which misses
+    /// bonds gets micro-moduli fitted to D by least squares from its own bonds and that
+    /// volume (3.20), as random particles do. The default.
+    VoronoiFit,
+    /// Clipped Voronoi volumes; the bulk micro-moduli scaled by the volume fraction.
+    Voronoi,
+    /// The source's SPLM: every particle the full lattice cell and the bulk moduli.
+    Lattice,
+    /// Full lattice cells; particles with missing bonds fitted (the former
+    /// `surface_correction = true`).
+    LatticeFit,
+}
+
+impl Surface {
+    pub fn name(self) -> &'static str {
+        match self {
+            Surface::VoronoiFit => "voronoi_fit",
+            Surface::Voronoi => "voronoi",
+            Surface::Lattice => "lattice",
+            Surface::LatticeFit => "lattice_fit",
+        }
+    }
 }
 
 impl DiscretisationSpec {
+    /// The boundary treatment: `surface`, or what `surface_correction` meant.
+    pub fn surface(&self) -> Surface {
+        match (self.surface, self.surface_correction) {
+            (Some(s), _) => s,
+            (None, Some(true)) => Surface::LatticeFit,
+            (None, Some(false)) => Surface::Lattice,
+            (None, None) => Surface::VoronoiFit,
+        }
+    }
+
     /// Whether the body is random particles (SPPM) rather than a lattice.
     pub fn is_random(&self) -> bool {
         self.lattice == "random"

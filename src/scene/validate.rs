@@ -109,18 +109,34 @@ impl Scene {
                     "[0, 0] for lattice = \"random\": a random particle set has no origin (change `seed` for another particle set; rotation_deg turns the set against the body)",
                 ));
             }
-            if d.surface_correction {
+            if d.surface_correction == Some(true) {
                 return Err(invalid(
                     "discretisation.surface_correction",
                     "true",
                     "false (or absent) for lattice = \"random\": every random particle gets its own least-squares micro-moduli already",
                 ));
             }
+            if let Some(s) = d.surface {
+                if s != super::Surface::VoronoiFit {
+                    return Err(invalid(
+                        "discretisation.surface",
+                        format!("\"{}\"", s.name()),
+                        "\"voronoi_fit\" (or absent) for lattice = \"random\": random particles always have their clipped Voronoi cells and their own least-squares micro-moduli",
+                    ));
+                }
+            }
         } else if let Some(f) = d.min_distance {
             return Err(invalid(
                 "discretisation.min_distance",
                 f,
                 "absent for lattice = \"hexagonal\" (it sets the random particles' spacing rule)",
+            ));
+        }
+        if let (Some(s), Some(c)) = (d.surface, d.surface_correction) {
+            return Err(invalid(
+                "discretisation.surface_correction",
+                c,
+                format!("absent when discretisation.surface is given (surface = \"{}\"): surface_correction = true is surface = \"lattice_fit\", false is surface = \"lattice\"", s.name()),
             ));
         }
         positive("discretisation.spacing", d.spacing)?;

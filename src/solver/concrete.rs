@@ -807,6 +807,31 @@ where
         .collect()
 }
 
+/// Each particle's least-squares strain of its damaged elastic stretches d_ij·S_e,ij at
+/// positions x (MODEL.md §7 and §13: the strain the criteria stress D·ε reads); the stress
+/// the outputs show is D_i times it (`model::stress`, "recovered stress").
+pub fn particle_strain<const D: usize, const K: usize, L: DamageLaw<D, K>>(
+    m: &Mechanics<D, K>,
+    c: &Concrete<D, K, L>,
+    x: &[SVector<f64, D>],
+) -> Vec<SMatrix<f64, D, D>>
+where
+    Dim<D>: Dimension<D>,
+{
+    (0..x.len())
+        .map(|i| {
+            let (sl, _) = slots::<D, K, L, true>(m, c, x, i);
+            let mut dse = [0.0; K];
+            for (k, s) in sl.iter().enumerate() {
+                if let Some(s) = s {
+                    dse[k] = s.d * s.se;
+                }
+            }
+            Dim::<D>::strain_tensor(&c.fit[i], &dse)
+        })
+        .collect()
+}
+
 /// A material model with state that replaces the elastic kernel for a run (dispatched once
 /// per step, never inside the particle loop).
 pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
@@ -833,6 +858,12 @@ pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
         m: &Mechanics<D, K>,
         x: &[nalgebra::SVector<f64, D>],
         volume: &[f64],
+    ) -> Vec<nalgebra::SMatrix<f64, D, D>>;
+    /// Each particle's strain from its damaged elastic stretches ([`particle_strain`]).
+    fn particle_strain(
+        &self,
+        m: &Mechanics<D, K>,
+        x: &[nalgebra::SVector<f64, D>],
     ) -> Vec<nalgebra::SMatrix<f64, D, D>>;
     /// The model itself, for tests that reach into its state (downcast to its type).
     fn as_any(&self) -> &dyn std::any::Any;
@@ -882,6 +913,13 @@ where
         volume: &[f64],
     ) -> Vec<SMatrix<f64, D, D>> {
         particle_stress(m, self, x, volume)
+    }
+    fn particle_strain(
+        &self,
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+    ) -> Vec<SMatrix<f64, D, D>> {
+        particle_strain(m, self, x)
     }
     fn as_any(&self) -> &dyn std::any::Any {
         self

@@ -408,6 +408,36 @@ pub fn static_response<const D: usize, const K: usize>(
         .collect())
 }
 
+/// Static linear-elastic response to applied forces (small strain): K·u = f on the free
+/// components, u = 0 on the constrained ones (rigid motions the constraints leave free are
+/// removed; the forces must not load them). Used to measure stiffnesses (the cantilever of
+/// `tests/surfaces.rs` and `benchmarks/surfaces.rs`).
+pub fn static_force_response<const D: usize, const K: usize>(
+    mech: &Mechanics<D, K>,
+    x0: &[SVector<f64, D>],
+    constrained: &[[bool; D]],
+    forces: &[SVector<f64, D>],
+) -> Result<Field<D>, ModalError> {
+    let n = x0.len();
+    let modes = mechanisms(x0, &mech.mass, constrained);
+    let mut op = LinearOperator::new(mech, x0);
+    let mut rhs = forces.to_vec();
+    mask(&mut rhs, constrained);
+    let mut z: Field<D> = vec![SVector::zeros(); n];
+    let mut w = CgWork::new(n);
+    conjugate_gradient(
+        &mut op,
+        constrained,
+        &modes,
+        &mech.mass,
+        &rhs,
+        &mut z,
+        1e-12,
+        &mut w,
+    )?;
+    Ok(z)
+}
+
 /// Jacobi preconditioning: zr = diag ∘ r.
 fn precondition<const D: usize>(
     r: &[SVector<f64, D>],

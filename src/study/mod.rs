@@ -17,6 +17,7 @@ pub mod angle_effect;
 pub mod cli;
 pub mod convergence;
 pub mod crack_path;
+pub mod elastic_checks;
 pub mod extrapolation;
 pub mod monte_carlo;
 pub mod objectivity;

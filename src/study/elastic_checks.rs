@@ -1,0 +1,213 @@
+//! Elastic stiffness of simple members against theory, solved statically (small strain):
+//! a cantilever against Timoshenko's tip stiffness and a plate in uniaxial tension against E.
+//! They measure how a discretisation's boundary particles carry stiffness
+//! (`discretisation.surface`; tests/surfaces.rs, benchmarks/surfaces.rs).
+
+use crate::run::{prepare_model, Model, RunError};
+use crate::scene::Scene;
+use crate::solver::linear::LinearOperator;
+use crate::solver::modal::{static_force_response, static_response};
+use nalgebra::{Matrix3, Vector2, Vector3};
+
+/// E, ν, thickness of the checks (plane stress).
+pub const E: f64 = 30e9;
+pub const NU: f64 = 0.2;
+pub const THICKNESS: f64 = 0.05;
+
+/// A lattice's placement and boundary treatment.
+#[derive(Clone, Copy, Debug)]
+pub struct Placement {
+    pub spacing: f64,
+    pub rotation_deg: f64,
+    pub offset: [f64; 2],
+    /// `discretisation.surface` ("voronoi_fit", "voronoi", "lattice", "lattice_fit").
+    pub surface: &'static str,
+}
+
+fn discretisation(p: &Placement) -> String {
+    format!(
+        "[discretisation]\nspacing = {}\nrotation_deg = {}\noffset = [{}, {}]\nsurface = \"{}\"\n",
+        p.spacing, p.rotation_deg, p.offset[0], p.offset[1], p.surface
+    )
+}
+
+fn material() -> String {
+    format!(
+        "[material]\nE = {E}\nnu = {NU}\nrho = 2400.0\nthickness = {THICKNESS}\nplane = \"stress\"\n"
+    )
+}
+
+/// A cantilever of depth h and free length `length` along x (y ∈ [0, h]), clamped (x and y
+/// held) over the three spacings x ∈ [−3·L0, 0] behind its root.
+pub fn cantilever_scene(h: f64, length: f64, p: &Placement) -> Result<Scene, RunError> {
+    let c = 3.0 * p.spacing;
+    let text = format!(
+        "name = \"cantilever\"\n[body]\nshape = \"rectangle\"\nwidth = {}\nheight = {h}\norigin = [{}, 0.0]\n{}{}[[groups]]\nname = \"root\"\nselect = {{ by = \"box\", min = [{}, -1.0], max = [0.0, {}] }}\nfix = [\"x\", \"y\"]\n",
+        length + c,
+        -c,
+        discretisation(p),
+        material(),
+        -c - 1.0,
+        h + 1.0
+    );
+    Ok(Scene::from_toml_str(&text, &[])?)
+}
+
+/// The cantilever's tip stiffness / Timoshenko's: a tip load P spread over the particles
+/// within one spacing of the free end in proportion to their volume, the tip deflection the
+/// load-weighted mean (work-conjugate) deflection, and Timoshenko's δ = P·L³/(3EI) +
+/// P·L/(κGA) (κ = 5/6) with L the load's centroid. Returns (ratio, model).
+pub fn cantilever_stiffness(h: f64, length: f64, p: &Placement) -> Result<(f64, Model), RunError> {
+    let model = prepare_model(&cantilever_scene(h, length, p)?)?;
+    let x0 = &model.particles.x0;
+    let vol = &model.particles.volume;
+    let tip: Vec<usize> = (0..x0.len())
+        .filter(|&i| x0[i].x >= length - 1.01 * p.spacing)
+        .collect();
+    let vt: f64 = tip.iter().map(|&i| vol[i]).sum();
+    let load = 1000.0;
+    let mut f = vec![Vector2::zeros(); x0.len()];
+    for &i in &tip {
+        f[i].y = load * vol[i] / vt;
+    }
+    let arm = tip.iter().map(|&i| x0[i].x * vol[i]).sum::<f64>() / vt;
+    let u = static_force_response(&model.mech, x0, &model.constrained, &f)?;
+    let delta = tip.iter().map(|&i| u[i].y * f[i].y).sum::<f64>() / load;
+    let inertia = THICKNESS * h.powi(3) / 12.0;
+    let shear = E / (2.0 * (1.0 + NU));
+    let theory =
+        load * arm.powi(3) / (3.0 * E * inertia) + load * arm / (5.0 / 6.0 * shear * THICKNESS * h);
+    Ok((theory / delta, model))
+}
+
+/// A plate `width` × `height` (y ∈ [0, height]) held in y over its two bottom rows, its
+/// bottom-centre particle held in x, its two top rows pulled 1e-4·height in y.
+pub fn plate_scene(width: f64, height: f64, p: &Placement) -> Result<Scene, RunError> {
+    let text = format!(
+        "name = \"plate\"\n[body]\nshape = \"rectangle\"\nwidth = {width}\nheight = {height}\n{}{}[[groups]]\nname = \"bottom\"\nselect = {{ by = \"edge\", edge = \"bottom\", rows = 2 }}\nfix = [\"y\"]\n[[groups]]\nname = \"anchor\"\nselect = {{ by = \"nearest\", point = [{}, 0.0] }}\nfix = [\"x\"]\n[[groups]]\nname = \"top\"\nselect = {{ by = \"edge\", edge = \"top\", rows = 2 }}\nload = {{ component = \"y\", displacement = {} }}\n[loading]\nend_periods = 4.0\n",
+        discretisation(p),
+        material(),
+        0.5 * width,
+        1e-4 * height
+    );
+    Ok(Scene::from_toml_str(&text, &[])?)
+}
+
+/// (E/E_input, ν/ν_input) of a plate in uniaxial tension as an engineer measures them:
+/// σ = F/(W·t) from the reaction of the pulled rows, the strains from an affine fit of the
+/// displacements over the middle half of the plate.
+pub fn plate_modulus(width: f64, height: f64, p: &Placement) -> Result<(f64, f64), RunError> {
+    let model = prepare_model(&plate_scene(width, height, p)?)?;
+    let n = model.particles.len();
+    let mut ubar = vec![Vector2::zeros(); n];
+    for pr in &model.prescribed {
+        ubar[pr.particle as usize][pr.component as usize] = pr.amplitude;
+    }
+    let x0 = &model.particles.x0;
+    let u = static_response(&model.mech, x0, &model.constrained, &ubar)?;
+    let mut op = LinearOperator::new(&model.mech, x0);
+    let mut f = vec![Vector2::zeros(); n];
+    op.internal_forces(&u, &mut f);
+    let top = model
+        .groups
+        .iter()
+        .find(|g| g.name == "top")
+        .expect("group");
+    let force = -top.members.iter().map(|&i| f[i as usize].y).sum::<f64>();
+    // affine fit u ≈ G·x + c over the middle half
+    let (cx, cy) = (0.5 * width, 0.5 * height);
+    let mut ata = Matrix3::zeros();
+    let mut atb = [Vector3::zeros(), Vector3::zeros()];
+    for (x, ui) in x0.iter().zip(&u) {
+        if (x.x - cx).abs() <= 0.25 * width && (x.y - cy).abs() <= 0.25 * height {
+            let row = Vector3::new(x.x, x.y, 1.0);
+            ata += row * row.transpose();
+            atb[0] += row * ui.x;
+            atb[1] += row * ui.y;
+        }
+    }
+    let inv = ata.try_inverse().expect("the middle half holds particles");
+    let (exx, eyy) = ((inv * atb[0])[0], (inv * atb[1])[1]);
+    let sigma = force / (width * THICKNESS);
+    Ok((sigma / eyy / E, -exx / eyy / NU))
+}
+
+/// A square plate of side `width` with a central circular hole of radius `radius`, held and
+/// pulled like [`plate_scene`] (uniaxial tension along y, 1e-4 strain).
+pub fn hole_plate_scene(width: f64, radius: f64, p: &Placement) -> Result<Scene, RunError> {
+    let text = format!(
+        "name = \"plate_with_hole\"\n[body]\nshape = \"rectangle\"\nwidth = {width}\nheight = {width}\n[[cutouts]]\nshape = \"disc\"\ncentre = [{c}, {c}]\ndiameter = {d}\n{}{}[[groups]]\nname = \"bottom\"\nselect = {{ by = \"edge\", edge = \"bottom\", rows = 2 }}\nfix = [\"y\"]\n[[groups]]\nname = \"anchor\"\nselect = {{ by = \"nearest\", point = [{c}, 0.0] }}\nfix = [\"x\"]\n[[groups]]\nname = \"top\"\nselect = {{ by = \"edge\", edge = \"top\", rows = 2 }}\nload = {{ component = \"y\", displacement = {u} }}\n[loading]\nend_periods = 4.0\n",
+        discretisation(p),
+        material(),
+        c = 0.5 * width,
+        d = 2.0 * radius,
+        u = 1e-4 * width
+    );
+    Ok(Scene::from_toml_str(&text, &[])?)
+}
+
+/// What the plate with a hole shows in the recovered stress (`run::stress_recovery`), all
+/// divided by the remote stress σ = F/(W·t).
+#[derive(Clone, Copy, Debug)]
+pub struct HoleStress {
+    /// σyy of the particles nearest the hole's two sides (x = centre ± R, on the hole's
+    /// axis), their mean: Kirsch's 3, Howland's 3.03 at 2R/W = 0.1.
+    pub hoop: f64,
+    /// The largest |σ·n·n| (normal stress on the hole's edge, n radial) among the particles
+    /// whose Voronoi cell meets the hole.
+    pub max_normal: f64,
+    /// The largest |σ_rθ| among them.
+    pub max_shear: f64,
+}
+
+/// Solve the plate with a hole statically and read [`HoleStress`].
+pub fn hole_stress(width: f64, radius: f64, p: &Placement) -> Result<HoleStress, RunError> {
+    use crate::run::stress_recovery::{elastic_strain, recovered_stress};
+    let model = prepare_model(&hole_plate_scene(width, radius, p)?)?;
+    let n = model.particles.len();
+    let mut ubar = vec![Vector2::zeros(); n];
+    for pr in &model.prescribed {
+        ubar[pr.particle as usize][pr.component as usize] = pr.amplitude;
+    }
+    let x0 = &model.particles.x0;
+    let u = static_response(&model.mech, x0, &model.constrained, &ubar)?;
+    let mut op = LinearOperator::new(&model.mech, x0);
+    let mut f = vec![Vector2::zeros(); n];
+    op.internal_forces(&u, &mut f);
+    let top = model
+        .groups
+        .iter()
+        .find(|g| g.name == "top")
+        .expect("group");
+    let remote = -top.members.iter().map(|&i| f[i as usize].y).sum::<f64>() / (width * THICKNESS);
+    let x: Vec<Vector2<f64>> = x0.iter().zip(&u).map(|(a, b)| a + b).collect();
+    let sigma = recovered_stress(&model, &elastic_strain(&model, &x));
+    let c = Vector2::new(0.5 * width, 0.5 * width);
+    let nearest = |q: Vector2<f64>| {
+        (0..n)
+            .min_by(|&a, &b| (x0[a] - q).norm().total_cmp(&(x0[b] - q).norm()))
+            .expect("particles")
+    };
+    let sides = [
+        nearest(c + Vector2::new(radius, 0.0)),
+        nearest(c - Vector2::new(radius, 0.0)),
+    ];
+    let hoop = sides.iter().map(|&i| sigma[i][(1, 1)]).sum::<f64>() / 2.0 / remote;
+    // particles whose cell meets the hole: within a spacing of its edge
+    let (mut max_normal, mut max_shear) = (0.0f64, 0.0f64);
+    for i in 0..n {
+        let r = x0[i] - c;
+        if r.norm() > radius + p.spacing {
+            continue;
+        }
+        let nr = r.normalize();
+        let t = Vector2::new(-nr.y, nr.x);
+        max_normal = max_normal.max((nr.dot(&(sigma[i] * nr)) / remote).abs());
+        max_shear = max_shear.max((t.dot(&(sigma[i] * nr)) / remote).abs());
+    }
+    Ok(HoleStress {
+        hoop,
+        max_normal,
+        max_shear,
+    })
+}
