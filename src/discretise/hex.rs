@@ -37,8 +37,9 @@ impl HexLattice {
     }
 
     /// Particles inside `shape`. Bonds whose midpoint or quarter points leave the body
-    /// (across a notch or a re-entrant corner) are not made; particles left with no bond are
-    /// dropped.
+    /// (across a notch or a re-entrant corner), or that pass through a cutout (a hole, a slit,
+    /// across a crack line; [`Shape2::segment_in_body`]) are not made; particles left with no
+    /// bond are dropped.
     pub fn fill(&self, shape: &Shape2) -> Particles<2, 6> {
         self.fill_slots(shape)
     }
@@ -98,11 +99,8 @@ impl HexLattice {
         for (p, &(i, j)) in coords.iter().enumerate() {
             for (k, (di, dj)) in STEPS.iter().enumerate() {
                 if let Some(&q) = index.get(&(i + di, j + dj)) {
-                    let (xa, xb) = (x0[p], x0[q as usize]);
-                    let inside = [0.25, 0.5, 0.75]
-                        .iter()
-                        .all(|s| shape.contains(&(xa + (xb - xa) * *s), tol));
-                    if inside {
+                    // quarter points against the outline, cutouts exactly
+                    if shape.segment_in_body(&x0[p], &x0[q as usize], tol, 4) {
                         neighbours[p][k] = q;
                         reverse[p][k] = ((k + 3) % 6) as u8;
                         l0[p][k] = self.spacing;

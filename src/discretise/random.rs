@@ -5,16 +5,19 @@
 //!
 //! - **Density.** The body receives as many particles as a hexagonal lattice of the same
 //!   spacing L0 would: area / ((√3/2)·L0²).
-//! - **Outline first.** The boundary is walked piece by piece (edges, arcs), each piece
-//!   divided into ⌈length/L0⌉ equal parts, so corners, notches and the supports' edges carry
-//!   particles; an outline point closer than the minimum distance to one already placed is
-//!   skipped (the two faces of a notch narrower than that).
+//! - **Outline first.** The boundary is walked piece by piece (edges, arcs; with cutouts
+//!   also the holes' edges and the faces of slits, notches and crack lines,
+//!   `Shape2::outline`), each piece divided into ⌈length/L0⌉ equal parts, so corners,
+//!   notches, holes and the supports' edges carry particles; an outline point closer than
+//!   the minimum distance to one already placed is skipped (the second face of a notch or
+//!   slit narrower than that; the second face of a crack line).
 //! - **Interior.** Uniform candidates in the bounding box, kept when inside the body and at
 //!   least `min_distance` from every particle so far (a background grid answers the query),
 //!   until the count is reached.
 //! - **Bonds.** The horizon of i reaches its 6th-nearest particle (3.50); a bond ij exists
 //!   where either end lists the other (the force needs both force states), and only where
-//!   the segment stays in the body (as for the lattice: no bond across a notch). Neighbour
+//!   the segment stays in the body (as for the lattice: no bond across a notch, through a
+//!   hole or across a crack line; `Shape2::segment_in_body`). Neighbour
 //!   counts therefore vary; they are stored in `K` fixed slots (empty slots hold
 //!   [`NONE`]), and a particle with more than `K` bonds is an error.
 //! - **Reproducible.** One ChaCha20 stream from the scene's seed, consumed in one order on
@@ -242,9 +245,8 @@ pub fn bond<const K: usize>(
     );
     let tol = 1e-9 * shape.size();
     // seven points along the bond: a bond of up to twice the spacing cannot step over a
-    // notch wider than a quarter of the spacing
-    let inside =
-        |a: &P, b: &P| (1..8).all(|s| shape.contains(&(a + (b - a) * (s as f64 / 8.0)), tol));
+    // notch of the outline wider than a quarter of the spacing; cutouts are tested exactly
+    let inside = |a: &P, b: &P| shape.segment_in_body(a, b, tol, 8);
     let mut lists: Vec<Vec<u32>> = vec![Vec::with_capacity(8); x.len()];
     for (i, p) in x.iter().enumerate() {
         for q in tree
