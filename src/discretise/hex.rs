@@ -235,4 +235,65 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn bonds_do_not_cross_a_hole_or_a_crack_line() {
+        use crate::geometry::Cutout;
+        let (c, r) = (Vector2::new(0.05, 0.05), 0.012);
+        let (a, b) = (Vector2::new(0.07, 0.02), Vector2::new(0.09, 0.09));
+        let s = Shape2::WithCutouts {
+            outer: Box::new(Shape2::Rectangle {
+                origin: Vector2::zeros(),
+                width: 0.1,
+                height: 0.1,
+            }),
+            cutouts: vec![
+                Cutout::Disc {
+                    centre: c,
+                    radius: r,
+                },
+                Cutout::slit(a, b, 0.0),
+            ],
+        };
+        for rot in [0.0, 15.0, 30.0, 45.0] {
+            let p = HexLattice {
+                spacing: 0.002,
+                rotation_deg: rot,
+                offset: Vector2::new(0.0003, 0.0007),
+                thickness: 0.05,
+            }
+            .fill(&s);
+            p.check_topology().unwrap();
+            let cross = |u: Vector2<f64>, v: Vector2<f64>| u.x * v.y - u.y * v.x;
+            let mut cut_by_crack = 0;
+            for i in 0..p.len() {
+                assert!((p.x0[i] - c).norm() >= r * (1.0 - 1e-9));
+                for k in 0..6 {
+                    let j = p.neighbours[i][k];
+                    if j == NONE {
+                        continue;
+                    }
+                    let (x, y) = (p.x0[i], p.x0[j as usize]);
+                    // the bond's closest approach to the hole's centre
+                    let d = y - x;
+                    let t = ((c - x).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+                    assert!(
+                        (x + d * t - c).norm() >= r * (1.0 - 1e-9),
+                        "{rot}°: {x:?}-{y:?}"
+                    );
+                    // the crack's two sides, and the bond's two sides
+                    let across = cross(b - a, x - a) * cross(b - a, y - a) < 0.0
+                        && cross(d, a - x) * cross(d, b - x) < 0.0;
+                    assert!(!across, "{rot}°: bond {x:?}-{y:?} crosses the crack");
+                }
+                // particles just beside the crack miss the bonds across it
+                let side = cross(b - a, p.x0[i] - a) / (b - a).norm();
+                let along = (p.x0[i] - a).dot(&(b - a)) / (b - a).norm_squared();
+                if side.abs() < 0.5 * 0.002 && (0.1..0.9).contains(&along) {
+                    cut_by_crack += 6 - p.bond_count(i);
+                }
+            }
+            assert!(cut_by_crack > 0);
+        }
+    }
 }

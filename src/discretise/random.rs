@@ -479,4 +479,61 @@ mod tests {
             }
         }
     }
+
+    /// A plate with a hole and a slit: the hole's edge and the slit's faces carry particles at
+    /// the spacing, no bond passes through either, and the cells sum to the area.
+    #[test]
+    fn holes_and_slits_carry_outline_particles_and_no_bonds() {
+        use crate::geometry::Cutout;
+        let (c, r) = (P::new(0.03, 0.03), 0.01);
+        let slit = Cutout::slit(P::new(0.07, 0.01), P::new(0.09, 0.05), 0.004);
+        let s = Shape2::WithCutouts {
+            outer: Box::new(shapes()[0].clone()),
+            cutouts: vec![
+                Cutout::Disc {
+                    centre: c,
+                    radius: r,
+                },
+                slit.clone(),
+            ],
+        };
+        let rec = recipe(9);
+        let (p, _, g) = fill::<SLOTS_2D>(&s, &rec).unwrap();
+        p.check_topology().unwrap();
+        let tol = 1e-9 * s.size();
+        let on_hole =
+            p.x0.iter()
+                .filter(|x| ((*x - c).norm() - r).abs() <= tol)
+                .count();
+        let expected = (2.0 * std::f64::consts::PI * r / rec.spacing).round() as usize;
+        assert_eq!(on_hole, expected);
+        // both faces of the slit (4 mm wide, more than the minimum distance) carry particles
+        let on_faces = p.x0.iter().filter(|x| slit.depth(x).abs() <= tol).count();
+        let faces = 2.0 * (0.02f64.powi(2) + 0.04f64.powi(2)).sqrt() / rec.spacing;
+        assert!(on_faces as f64 >= faces, "{on_faces}");
+        for i in 0..p.len() {
+            for k in 0..SLOTS_2D {
+                let j = p.neighbours[i][k];
+                if j == NONE {
+                    continue;
+                }
+                let (a, b) = (p.x0[i], p.x0[j as usize]);
+                assert!(
+                    !slit.cuts_segment(&a, &b, tol),
+                    "{a:?}-{b:?} through the slit"
+                );
+                // through the hole: only the short chords between its outline particles
+                let d = b - a;
+                let t = ((c - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+                if (a + d * t - c).norm() < r - tol {
+                    assert!(((a - c).norm() - r).abs() <= tol && ((b - c).norm() - r).abs() <= tol);
+                    assert!(d.norm() <= r);
+                }
+            }
+        }
+        let cells = voronoi::clipped_cells(&p.x0, &s).unwrap();
+        let sum: f64 = cells.iter().map(|c| c.1).sum();
+        assert!((sum - s.area()).abs() / s.area() < 1e-9);
+        assert!(g.outline_particles >= on_hole + on_faces);
+    }
 }

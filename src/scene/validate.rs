@@ -494,7 +494,7 @@ impl Scene {
                     point(&format!("{key}.start"), start)?;
                     point(&format!("{key}.end"), end)?;
                     let length = (Vector2::new(end[0] - start[0], end[1] - start[1])).norm();
-                    if !(length > 1e-9 * size) {
+                    if length <= 1e-9 * size {
                         return Err(invalid(
                             format!("{key}.end"),
                             format!("{end:?}"),
