@@ -53,6 +53,14 @@ const GOLDEN: &[Golden] = &[
         steps: 42620,
         particles: 5858,
     },
+    // A plate with a circular hole (cutouts), recorded when it was added to lattices/.
+    Golden {
+        scene: "plate_with_hole",
+        peak_force_n: 14829.978068683713,
+        dissipated_energy_j: -8.40817216199441e-14,
+        steps: 43510,
+        particles: 45952,
+    },
     Golden {
         scene: "split_cylinder",
         peak_force_n: 241421.2638407034,
@@ -191,6 +199,11 @@ fn golden_dogbone_montecarlo() {
 #[test]
 fn golden_elastic_plate() {
     check("elastic_plate", "2");
+}
+
+#[test]
+fn golden_plate_with_hole() {
+    check("plate_with_hole", "2");
 }
 
 #[test]

@@ -37,8 +37,9 @@ impl HexLattice {
     }
 
     /// Particles inside `shape`. Bonds whose midpoint or quarter points leave the body
-    /// (across a notch or a re-entrant corner) are not made; particles left with no bond are
-    /// dropped.
+    /// (across a notch or a re-entrant corner), or that pass through a cutout (a hole, a slit,
+    /// across a crack line; [`Shape2::segment_in_body`]) are not made; particles left with no
+    /// bond are dropped.
     pub fn fill(&self, shape: &Shape2) -> Particles<2, 6> {
         self.fill_slots(shape)
     }
@@ -98,11 +99,8 @@ impl HexLattice {
         for (p, &(i, j)) in coords.iter().enumerate() {
             for (k, (di, dj)) in STEPS.iter().enumerate() {
                 if let Some(&q) = index.get(&(i + di, j + dj)) {
-                    let (xa, xb) = (x0[p], x0[q as usize]);
-                    let inside = [0.25, 0.5, 0.75]
-                        .iter()
-                        .all(|s| shape.contains(&(xa + (xb - xa) * *s), tol));
-                    if inside {
+                    // quarter points against the outline, cutouts exactly
+                    if shape.segment_in_body(&x0[p], &x0[q as usize], tol, 4) {
                         neighbours[p][k] = q;
                         reverse[p][k] = ((k + 3) % 6) as u8;
                         l0[p][k] = self.spacing;
@@ -235,6 +233,67 @@ mod tests {
                 let crosses = (a.x - 0.1) * (b.x - 0.1) < 0.0 && a.y.max(b.y) < 0.025;
                 assert!(!crosses, "bond {a:?}-{b:?} crosses the notch");
             }
+        }
+    }
+
+    #[test]
+    fn bonds_do_not_cross_a_hole_or_a_crack_line() {
+        use crate::geometry::Cutout;
+        let (c, r) = (Vector2::new(0.05, 0.05), 0.012);
+        let (a, b) = (Vector2::new(0.07, 0.02), Vector2::new(0.09, 0.09));
+        let s = Shape2::WithCutouts {
+            outer: Box::new(Shape2::Rectangle {
+                origin: Vector2::zeros(),
+                width: 0.1,
+                height: 0.1,
+            }),
+            cutouts: vec![
+                Cutout::Disc {
+                    centre: c,
+                    radius: r,
+                },
+                Cutout::slit(a, b, 0.0),
+            ],
+        };
+        for rot in [0.0, 15.0, 30.0, 45.0] {
+            let p = HexLattice {
+                spacing: 0.002,
+                rotation_deg: rot,
+                offset: Vector2::new(0.0003, 0.0007),
+                thickness: 0.05,
+            }
+            .fill(&s);
+            p.check_topology().unwrap();
+            let cross = |u: Vector2<f64>, v: Vector2<f64>| u.x * v.y - u.y * v.x;
+            let mut cut_by_crack = 0;
+            for i in 0..p.len() {
+                assert!((p.x0[i] - c).norm() >= r * (1.0 - 1e-9));
+                for k in 0..6 {
+                    let j = p.neighbours[i][k];
+                    if j == NONE {
+                        continue;
+                    }
+                    let (x, y) = (p.x0[i], p.x0[j as usize]);
+                    // the bond's closest approach to the hole's centre
+                    let d = y - x;
+                    let t = ((c - x).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+                    assert!(
+                        (x + d * t - c).norm() >= r * (1.0 - 1e-9),
+                        "{rot}°: {x:?}-{y:?}"
+                    );
+                    // the crack's two sides, and the bond's two sides
+                    let across = cross(b - a, x - a) * cross(b - a, y - a) < 0.0
+                        && cross(d, a - x) * cross(d, b - x) < 0.0;
+                    assert!(!across, "{rot}°: bond {x:?}-{y:?} crosses the crack");
+                }
+                // particles just beside the crack miss the bonds across it
+                let side = cross(b - a, p.x0[i] - a) / (b - a).norm();
+                let along = (p.x0[i] - a).dot(&(b - a)) / (b - a).norm_squared();
+                if side.abs() < 0.5 * 0.002 && (0.1..0.9).contains(&along) {
+                    cut_by_crack += 6 - p.bond_count(i);
+                }
+            }
+            assert!(cut_by_crack > 0);
         }
     }
 }

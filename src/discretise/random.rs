@@ -5,16 +5,19 @@
 //!
 //! - **Density.** The body receives as many particles as a hexagonal lattice of the same
 //!   spacing L0 would: area / ((√3/2)·L0²).
-//! - **Outline first.** The boundary is walked piece by piece (edges, arcs), each piece
-//!   divided into ⌈length/L0⌉ equal parts, so corners, notches and the supports' edges carry
-//!   particles; an outline point closer than the minimum distance to one already placed is
-//!   skipped (the two faces of a notch narrower than that).
+//! - **Outline first.** The boundary is walked piece by piece (edges, arcs; with cutouts
+//!   also the holes' edges and the faces of slits, notches and crack lines,
+//!   `Shape2::outline`), each piece divided into ⌈length/L0⌉ equal parts, so corners,
+//!   notches, holes and the supports' edges carry particles; an outline point closer than
+//!   the minimum distance to one already placed is skipped (the second face of a notch or
+//!   slit narrower than that; the second face of a crack line).
 //! - **Interior.** Uniform candidates in the bounding box, kept when inside the body and at
 //!   least `min_distance` from every particle so far (a background grid answers the query),
 //!   until the count is reached.
 //! - **Bonds.** The horizon of i reaches its 6th-nearest particle (3.50); a bond ij exists
 //!   where either end lists the other (the force needs both force states), and only where
-//!   the segment stays in the body (as for the lattice: no bond across a notch). Neighbour
+//!   the segment stays in the body (as for the lattice: no bond across a notch, through a
+//!   hole or across a crack line; `Shape2::segment_in_body`). Neighbour
 //!   counts therefore vary; they are stored in `K` fixed slots (empty slots hold
 //!   [`NONE`]), and a particle with more than `K` bonds is an error.
 //! - **Reproducible.** One ChaCha20 stream from the scene's seed, consumed in one order on
@@ -242,9 +245,8 @@ pub fn bond<const K: usize>(
     );
     let tol = 1e-9 * shape.size();
     // seven points along the bond: a bond of up to twice the spacing cannot step over a
-    // notch wider than a quarter of the spacing
-    let inside =
-        |a: &P, b: &P| (1..8).all(|s| shape.contains(&(a + (b - a) * (s as f64 / 8.0)), tol));
+    // notch of the outline wider than a quarter of the spacing; cutouts are tested exactly
+    let inside = |a: &P, b: &P| shape.segment_in_body(a, b, tol, 8);
     let mut lists: Vec<Vec<u32>> = vec![Vec::with_capacity(8); x.len()];
     for (i, p) in x.iter().enumerate() {
         for q in tree
@@ -476,5 +478,62 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A plate with a hole and a slit: the hole's edge and the slit's faces carry particles at
+    /// the spacing, no bond passes through either, and the cells sum to the area.
+    #[test]
+    fn holes_and_slits_carry_outline_particles_and_no_bonds() {
+        use crate::geometry::Cutout;
+        let (c, r) = (P::new(0.03, 0.03), 0.01);
+        let slit = Cutout::slit(P::new(0.07, 0.01), P::new(0.09, 0.05), 0.004);
+        let s = Shape2::WithCutouts {
+            outer: Box::new(shapes()[0].clone()),
+            cutouts: vec![
+                Cutout::Disc {
+                    centre: c,
+                    radius: r,
+                },
+                slit.clone(),
+            ],
+        };
+        let rec = recipe(9);
+        let (p, _, g) = fill::<SLOTS_2D>(&s, &rec).unwrap();
+        p.check_topology().unwrap();
+        let tol = 1e-9 * s.size();
+        let on_hole =
+            p.x0.iter()
+                .filter(|x| ((*x - c).norm() - r).abs() <= tol)
+                .count();
+        let expected = (2.0 * std::f64::consts::PI * r / rec.spacing).round() as usize;
+        assert_eq!(on_hole, expected);
+        // both faces of the slit (4 mm wide, more than the minimum distance) carry particles
+        let on_faces = p.x0.iter().filter(|x| slit.depth(x).abs() <= tol).count();
+        let faces = 2.0 * (0.02f64.powi(2) + 0.04f64.powi(2)).sqrt() / rec.spacing;
+        assert!(on_faces as f64 >= faces, "{on_faces}");
+        for i in 0..p.len() {
+            for k in 0..SLOTS_2D {
+                let j = p.neighbours[i][k];
+                if j == NONE {
+                    continue;
+                }
+                let (a, b) = (p.x0[i], p.x0[j as usize]);
+                assert!(
+                    !slit.cuts_segment(&a, &b, tol),
+                    "{a:?}-{b:?} through the slit"
+                );
+                // through the hole: only the short chords between its outline particles
+                let d = b - a;
+                let t = ((c - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+                if (a + d * t - c).norm() < r - tol {
+                    assert!(((a - c).norm() - r).abs() <= tol && ((b - c).norm() - r).abs() <= tol);
+                    assert!(d.norm() <= r);
+                }
+            }
+        }
+        let cells = voronoi::clipped_cells(&p.x0, &s).unwrap();
+        let sum: f64 = cells.iter().map(|c| c.1).sum();
+        assert!((sum - s.area()).abs() / s.area() < 1e-9);
+        assert!(g.outline_particles >= on_hole + on_faces);
     }
 }

@@ -145,6 +145,9 @@ struct Frame {
     pos: Vec<(f64, f64)>,
     /// Random particles: each particle's Voronoi cell (mm), moved with the particle.
     cells: Option<Vec<Vec<(f64, f64)>>>,
+    /// The edges of the body's cutouts (holes, slits, notches; mm), each point moved with the
+    /// particle nearest it; empty without cutouts.
+    cutouts: Vec<Vec<(f64, f64)>>,
     x: std::ops::Range<f64>,
     y: std::ops::Range<f64>,
     plot_w: f64,
@@ -186,6 +189,7 @@ impl Frame {
                 .collect()
         });
         Frame {
+            cutouts: cutout_edges(o, scale),
             pos,
             cells,
             x: x0..x1,
@@ -225,6 +229,21 @@ impl Frame {
         }
     }
 
+    /// The cutouts' edges as thin black lines (nothing without cutouts).
+    fn draw_cutouts<'a, 'b>(
+        &self,
+        chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ) -> anyhow::Result<()> {
+        chart
+            .draw_series(
+                self.cutouts
+                    .iter()
+                    .map(|line| PathElement::new(line.clone(), BLACK.stroke_width(1))),
+            )
+            .map(|_| ())
+            .map_err(err)
+    }
+
     /// Axes in mm on `area`, titled "<scene>: <what>" (with the magnification if any).
     fn chart<'a, 'b>(
         &self,
@@ -257,6 +276,37 @@ impl Frame {
             .map_err(err)?;
         Ok(chart)
     }
+}
+
+/// The edges of the scene's cutouts in mm (`Shape2::cutout_outlines`), each point moved by
+/// scale × the displacement of the particle nearest it; empty without cutouts.
+fn cutout_edges(o: &Outcome, scale: f64) -> Vec<Vec<(f64, f64)>> {
+    if o.scene.cutouts.is_empty() || o.x0.is_empty() {
+        return vec![];
+    }
+    let lines = o.scene.shape().cutout_outlines();
+    let tree = (scale != 0.0).then(|| {
+        rstar::RTree::bulk_load(
+            o.x0.iter()
+                .enumerate()
+                .map(|(i, x)| rstar::primitives::GeomWithData::new([x[0], x[1]], i))
+                .collect::<Vec<_>>(),
+        )
+    });
+    lines
+        .iter()
+        .map(|line| {
+            line.iter()
+                .map(|p| {
+                    let u = tree
+                        .as_ref()
+                        .and_then(|t| t.nearest_neighbor(&[p.x, p.y]))
+                        .map_or([0.0; 3], |q| o.displacement[q.data]);
+                    ((p.x + scale * u[0]) * 1e3, (p.y + scale * u[1]) * 1e3)
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// particle_map.svg: every particle as a disc (random particles: as its Voronoi cell)
@@ -318,6 +368,7 @@ fn value_map(
         &mut chart,
         values.iter().map(|&v| viridis((v - vmin) / span)),
     )?;
+    frame.draw_cutouts(&mut chart)?;
     if let (true, Some(damage)) = (cracks, &o.damage) {
         chart
             .draw_series(
@@ -395,6 +446,7 @@ pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
     )?;
     let (pos, radius) = (&frame.pos, frame.radius);
     frame.fill(&mut chart, damage.iter().map(|d| damage_colour(d.wt)))?;
+    frame.draw_cutouts(&mut chart)?;
     chart
         .draw_series(
             pos.iter()

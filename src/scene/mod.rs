@@ -31,6 +31,9 @@ pub struct Scene {
     #[serde(default)]
     pub seed: Option<u64>,
     pub body: BodySpec,
+    /// Holes, slits, notches and crack lines cut out of the body (`[[cutouts]]`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cutouts: Vec<CutoutSpec>,
     pub discretisation: DiscretisationSpec,
     pub material: MaterialSpec,
     /// Concrete damage and plasticity (MODEL.md §6–9, §11); its presence turns them on.
@@ -161,6 +164,66 @@ pub enum BodySpec {
         notch_depth: f64,
         notch_width: f64,
     },
+}
+
+/// A region cut out of the body (`[[cutouts]] shape = "..."`). Lengths in metres. The body
+/// is the outer shape less the open interiors of its cutouts: a particle on a cutout's edge
+/// belongs to the body. A cutout may lie inside the body (a hole, an internal slit) or cross
+/// its outline (a notch); cutouts must not overlap (a crack line may cross others).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+pub enum CutoutSpec {
+    /// A circular hole.
+    Disc { centre: [f64; 2], diameter: f64 },
+    /// A simple polygon, vertices in either orientation.
+    Polygon { vertices: Vec<[f64; 2]> },
+    /// The rectangle of `width` about the segment start–end, at any angle; `width = 0` is a
+    /// crack line: it removes no area, only the bonds that cross it.
+    Slit {
+        start: [f64; 2],
+        end: [f64; 2],
+        width: f64,
+    },
+    /// A rectangle `width` × `height` with its lower-left corner at `origin`, turned by
+    /// `rotation_deg` about the origin.
+    Rectangle {
+        origin: [f64; 2],
+        width: f64,
+        height: f64,
+        #[serde(default)]
+        rotation_deg: f64,
+    },
+}
+
+impl CutoutSpec {
+    /// The cutout's geometry.
+    pub fn cutout(&self) -> crate::geometry::Cutout {
+        use crate::geometry::Cutout;
+        use nalgebra::Vector2;
+        let v = |a: &[f64; 2]| Vector2::new(a[0], a[1]);
+        match self {
+            CutoutSpec::Disc { centre, diameter } => Cutout::Disc {
+                centre: v(centre),
+                radius: 0.5 * diameter,
+            },
+            CutoutSpec::Polygon { vertices } => {
+                Cutout::polygon(&vertices.iter().map(v).collect::<Vec<_>>())
+            }
+            CutoutSpec::Slit { start, end, width } => Cutout::slit(v(start), v(end), *width),
+            CutoutSpec::Rectangle {
+                origin,
+                width,
+                height,
+                rotation_deg,
+            } => Cutout::rectangle(v(origin), *width, *height, *rotation_deg),
+        }
+    }
+
+    /// The cutout as the scene writes it, an inline TOML table
+    /// (`{ shape = "disc", centre = [0.1, 0.1], diameter = 0.01 }`), for messages.
+    pub fn scene_text(&self) -> String {
+        inline_table(self, "shape")
+    }
 }
 
 /// How the body is filled with particles.
@@ -465,28 +528,35 @@ impl Selection {
     /// The selection as the scene writes it, an inline TOML table
     /// (`{ by = "box", max = [0.1, 0.2], min = [0.0, 0.0] }`), for messages.
     pub fn scene_text(&self) -> String {
-        fn inline(v: &serde_json::Value) -> String {
-            match v {
-                serde_json::Value::Array(items) => {
-                    let items: Vec<String> = items.iter().map(inline).collect();
-                    format!("[{}]", items.join(", "))
-                }
-                other => other.to_string(),
-            }
-        }
-        let value = serde_json::to_value(self).unwrap_or_default();
-        let Some(map) = value.as_object() else {
-            return inline(&value);
-        };
-        // `by` first, as a scene writes it
-        let mut items: Vec<String> = map
-            .iter()
-            .filter(|(_, v)| !v.is_null())
-            .map(|(k, v)| format!("{k} = {}", inline(v)))
-            .collect();
-        items.sort_by_key(|s| !s.starts_with("by ="));
-        format!("{{ {} }}", items.join(", "))
+        inline_table(self, "by")
     }
+}
+
+/// A tagged table as an inline TOML table, its tag `first` (`{ by = "box", max = [0.1, 0.2],
+/// min = [0.0, 0.0] }`), for messages.
+fn inline_table<T: Serialize>(table: &T, first: &str) -> String {
+    fn inline(v: &serde_json::Value) -> String {
+        match v {
+            serde_json::Value::Array(items) => {
+                let items: Vec<String> = items.iter().map(inline).collect();
+                format!("[{}]", items.join(", "))
+            }
+            other => other.to_string(),
+        }
+    }
+    let value = serde_json::to_value(table).unwrap_or_default();
+    let Some(map) = value.as_object() else {
+        return inline(&value);
+    };
+    // the tag first, as a scene writes it
+    let mut items: Vec<String> = map
+        .iter()
+        .filter(|(_, v)| !v.is_null())
+        .map(|(k, v)| format!("{k} = {}", inline(v)))
+        .collect();
+    let tag = format!("{first} =");
+    items.sort_by_key(|s| !s.starts_with(&tag));
+    format!("{{ {} }}", items.join(", "))
 }
 
 /// Displacement loading of one component of a group.

@@ -83,6 +83,7 @@ impl Scene {
             }
         }
         self.validate_body()?;
+        self.validate_cutouts()?;
         super::random_fields::check(self)?;
         let d = &self.discretisation;
         if d.lattice != "hexagonal" && d.lattice != "random" {
@@ -456,6 +457,170 @@ impl Scene {
         Ok(())
     }
 
+    /// The values of `[[cutouts]]`, then their geometry: each must meet the body, one that
+    /// crosses the outline must have an exact area (every cutout but a disc across a disc's
+    /// or a dog-bone's arc), none may overlap another (crack lines aside), and together they
+    /// must leave some of the body.
+    fn validate_cutouts(&self) -> Result<(), SceneError> {
+        use crate::geometry::{cutout_area_in, Cutout, Shape2};
+        if self.cutouts.is_empty() {
+            return Ok(());
+        }
+        let outer = self.outer_shape();
+        let size = outer.size();
+        let point = |key: &str, p: &[f64; 2]| -> Result<(), SceneError> {
+            finite(&format!("{key}[0]"), p[0])?;
+            finite(&format!("{key}[1]"), p[1])
+        };
+        for (i, c) in self.cutouts.iter().enumerate() {
+            let key = format!("cutouts[{i}]");
+            match c {
+                CutoutSpec::Disc { centre, diameter } => {
+                    point(&format!("{key}.centre"), centre)?;
+                    positive(&format!("{key}.diameter"), *diameter)?;
+                }
+                CutoutSpec::Polygon { vertices } => {
+                    if vertices.len() < 3 {
+                        return Err(invalid(
+                            format!("{key}.vertices"),
+                            format!("{} vertices", vertices.len()),
+                            "at least 3 vertices",
+                        ));
+                    }
+                    for (k, v) in vertices.iter().enumerate() {
+                        point(&format!("{key}.vertices[{k}]"), v)?;
+                    }
+                    let pts: Vec<_> = vertices.iter().map(|v| Vector2::new(v[0], v[1])).collect();
+                    if crate::geometry::polygon_area(&pts).abs() <= 0.0 {
+                        return Err(invalid(
+                            format!("{key}.vertices"),
+                            format!("{vertices:?}"),
+                            "a polygon with non-zero area",
+                        ));
+                    }
+                    if polygon_self_intersects(&pts) {
+                        return Err(invalid(
+                            format!("{key}.vertices"),
+                            format!("{vertices:?}"),
+                            "a simple polygon: each vertex once, edges that neither cross, touch nor overlap",
+                        ));
+                    }
+                }
+                CutoutSpec::Slit { start, end, width } => {
+                    point(&format!("{key}.start"), start)?;
+                    point(&format!("{key}.end"), end)?;
+                    let length = (Vector2::new(end[0] - start[0], end[1] - start[1])).norm();
+                    if length <= 1e-9 * size {
+                        return Err(invalid(
+                            format!("{key}.end"),
+                            format!("{end:?}"),
+                            format!(
+                                "a slit of non-zero length: end must differ from start = {start:?}"
+                            ),
+                        ));
+                    }
+                    if !(width.is_finite() && *width >= 0.0) {
+                        return Err(invalid(
+                            format!("{key}.width"),
+                            width,
+                            "a finite width >= 0 (0: a crack line, which removes no area, only the bonds that cross it)",
+                        ));
+                    }
+                }
+                CutoutSpec::Rectangle {
+                    origin,
+                    width,
+                    height,
+                    rotation_deg,
+                } => {
+                    point(&format!("{key}.origin"), origin)?;
+                    positive(&format!("{key}.width"), *width)?;
+                    positive(&format!("{key}.height"), *height)?;
+                    finite(&format!("{key}.rotation_deg"), *rotation_deg)?;
+                }
+            }
+        }
+        let cutouts: Vec<Cutout> = self.cutouts.iter().map(CutoutSpec::cutout).collect();
+        let outer_area = outer.area();
+        for (i, (c, spec)) in cutouts.iter().zip(&self.cutouts).enumerate() {
+            let (lo, hi) = outer.bounding_box();
+            let outside = || {
+                invalid(
+                    format!("cutouts[{i}]"),
+                    spec.scene_text(),
+                    format!(
+                        "a cutout that meets the body; this one lies outside the body (the body spans x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m)",
+                        lo.x, hi.x, lo.y, hi.y
+                    ),
+                )
+            };
+            let whole = || {
+                invalid(
+                    format!("cutouts[{i}]"),
+                    spec.scene_text(),
+                    "a cutout that leaves some of the body; this one removes the whole body",
+                )
+            };
+            if !c.removes_area() {
+                let alone = Shape2::WithCutouts {
+                    outer: Box::new(outer.clone()),
+                    cutouts: vec![c.clone()],
+                };
+                if alone.cutout_outlines().is_empty() {
+                    return Err(outside());
+                }
+                continue;
+            }
+            let own = c.area();
+            match cutout_area_in(&outer, c, None) {
+                Some(a) if a <= 1e-9 * own => return Err(outside()),
+                Some(a) if a >= (1.0 - 1e-9) * outer_area => return Err(whole()),
+                Some(_) => {}
+                None => {
+                    // a disc across an arc: classify it on the chords, to name the problem
+                    let a = crate::geometry::cutout_area_in_or_chords(&outer, c, None);
+                    if a <= 1e-6 * own {
+                        return Err(outside());
+                    }
+                    if a >= (1.0 - 1e-6) * outer_area {
+                        return Err(whole());
+                    }
+                    return Err(invalid(
+                        format!("cutouts[{i}]"),
+                        spec.scene_text(),
+                        "a disc cutout inside the body or clear of it: a disc that crosses the arc of a disc or dog-bone body has no exact area here (its particles' volumes would be wrong); move it inside the body, or cut the notch as a polygon",
+                    ));
+                }
+            }
+        }
+        for j in 0..cutouts.len() {
+            for i in 0..j {
+                let overlap = cutouts[i].overlap_area(&cutouts[j]);
+                if overlap > 1e-9 * cutouts[i].area().min(cutouts[j].area()) {
+                    return Err(invalid(
+                        format!("cutouts[{j}]"),
+                        self.cutouts[j].scene_text(),
+                        format!(
+                            "cutouts must not overlap: this one overlaps cutouts[{i}] = {} by {overlap:.4e} m² (a slit of width 0, a crack line, may cross others)",
+                            self.cutouts[i].scene_text()
+                        ),
+                    ));
+                }
+            }
+        }
+        let area = self.shape().area();
+        if area <= 1e-9 * outer_area {
+            return Err(invalid(
+                "cutouts",
+                format!("{} cutouts", cutouts.len()),
+                format!(
+                    "cutouts that leave some of the body; these remove all of it ({outer_area:.4e} m²)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// The body's smallest overall dimension (m).
     pub fn body_size(&self) -> f64 {
         match &self.body {
@@ -470,8 +635,21 @@ impl Scene {
         }
     }
 
-    /// The geometric shape of the body.
+    /// The geometric shape of the body: the outer shape ([`Self::outer_shape`]) and, when the
+    /// scene has cutouts, less them (`Shape2::WithCutouts`).
     pub fn shape(&self) -> crate::geometry::Shape2 {
+        let outer = self.outer_shape();
+        if self.cutouts.is_empty() {
+            return outer;
+        }
+        crate::geometry::Shape2::WithCutouts {
+            outer: Box::new(outer),
+            cutouts: self.cutouts.iter().map(CutoutSpec::cutout).collect(),
+        }
+    }
+
+    /// The shape of `[body]`, without the cutouts.
+    pub fn outer_shape(&self) -> crate::geometry::Shape2 {
         use crate::geometry::Shape2;
         match &self.body {
             BodySpec::Rectangle {
