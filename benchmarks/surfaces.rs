@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release --example surfaces` (about a minute on 2 cores).
 
-use sppm::study::elastic_checks::{cantilever_stiffness, plate_modulus, Placement};
+use sppm::study::elastic_checks::{cantilever_stiffness, hole_stress, plate_modulus, Placement};
 
 const METHODS: [&str; 4] = ["voronoi_fit", "voronoi", "lattice", "lattice_fit"];
 const L0: f64 = 0.001;
@@ -12,6 +12,25 @@ const L0: f64 = 0.001;
 const OFFSETS: [[f64; 2]; 3] = [[0.0, 0.0], [0.37, 0.61], [0.83, 0.12]];
 
 fn main() {
+    println!("# plate with a hole, W = 20·R, uniaxial tension, recovered stress / remote: hoop stress at the hole's sides (Howland 3.03), largest |σ_rr| and |σ_rθ| on the hole's edge");
+    println!("| R/L0 | rotation | hoop | max σ_rr | max σ_rθ |");
+    println!("|---|---|---|---|---|");
+    for r in [10.0, 20.0] {
+        for rot in [0.0, 30.0] {
+            let p = Placement {
+                spacing: L0,
+                rotation_deg: rot,
+                offset: [0.0, 0.0],
+                surface: "voronoi_fit",
+            };
+            let s = hole_stress(20.0 * r * L0, r * L0, &p).expect("plate with a hole");
+            println!(
+                "| {r} | {rot}° | {:.3} | {:.3} | {:.3} |",
+                s.hoop, s.max_normal, s.max_shear
+            );
+        }
+    }
+    println!();
     println!("# plate in uniaxial tension (W × 2W, pulled along 2W): E/E0 − 1, ν/ν0 − 1 (%)");
     println!("| W/L0 | rotation | {} |", METHODS.join(" | "));
     println!("|---|---|{}", "---|".repeat(METHODS.len()));

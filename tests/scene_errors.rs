@@ -389,6 +389,24 @@ fn random_particle_keys() {
         "discretisation.surface_correction=true",
     ]);
     says(&msg, &["discretisation.surface_correction", "random"]);
+    let msg = error_of(&[
+        "discretisation.lattice=\"random\"",
+        "discretisation.surface=\"lattice\"",
+    ]);
+    says(
+        &msg,
+        &["discretisation.surface", "lattice", "random", "voronoi_fit"],
+    );
+    let msg = error_of(&[
+        "discretisation.surface=\"voronoi\"",
+        "discretisation.surface_correction=false",
+    ]);
+    says(
+        &msg,
+        &["discretisation.surface_correction", "false", "lattice_fit"],
+    );
+    let msg = error_of(&["discretisation.surface=\"clipped\""]);
+    says(&msg, &["discretisation.surface", "clipped"]);
     let msg = error_of(&["discretisation.lattice=\"random\"", "seed=1.5"]);
     says(&msg, &["seed", "1.5"]);
     let msg = error_of(&["discretisation.lattice=\"voronoi\""]);

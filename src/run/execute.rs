@@ -156,11 +156,26 @@ fn run_prepared<const K: usize>(
         .map(|(a, b)| a - b)
         .collect();
     // the recovered stress D_i·ε_i (run::stress_recovery), not (3.18)
-    let (strain, damage) = match &sim.inelastic {
-        Some(model) => (model.particle_strain(&sim.mech, &x), Some(model.damage())),
-        None => (stress_recovery::elastic_strain(&p.model, &x), None),
+    let (stress, damage) = match &sim.inelastic {
+        Some(model) => {
+            let damage = model.damage();
+            let intact = |j: usize| {
+                let d = &damage[j];
+                d.wt == 0.0 && d.wc == 0.0 && !d.yielded
+            };
+            let strain = stress_recovery::recovered_strain(
+                &p.model,
+                &x,
+                model.particle_strain(&sim.mech, &x),
+                &intact,
+            );
+            (
+                stress_recovery::recovered_stress(&p.model, &strain),
+                Some(damage),
+            )
+        }
+        None => (stress_recovery::elastic_stress(&p.model, &x), None),
     };
-    let stress = stress_recovery::recovered_stress(&p.model, &strain);
     let summary = summarise(
         &p,
         &Finished {
