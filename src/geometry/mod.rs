@@ -273,6 +273,12 @@ impl Shape2 {
                 }
                 let mut edges = 0;
                 for c in cutouts {
+                    // far from the cutout's box: neither in it nor on its edge
+                    let (lo, hi) = c.bounding_box();
+                    let m = tol.abs();
+                    if p.x < lo.x - m || p.x > hi.x + m || p.y < lo.y - m || p.y > hi.y + m {
+                        continue;
+                    }
                     let d = c.depth(p);
                     if d > tol {
                         return false;
@@ -332,7 +338,17 @@ impl Shape2 {
             (1..parts).all(|k| self.contains(&(a + (b - a) * (k as f64 / parts as f64)), tol));
         match self {
             Shape2::WithCutouts { cutouts, .. } => {
-                sampled && !cutouts.iter().any(|c| c.cuts_segment(a, b, tol))
+                let (slo, shi) = (a.inf(b), a.sup(b));
+                sampled
+                    && !cutouts.iter().any(|c| {
+                        let (lo, hi) = c.bounding_box();
+                        // boxes apart by more than tol: the bond misses the cutout
+                        let apart = slo.x > hi.x + tol
+                            || shi.x < lo.x - tol
+                            || slo.y > hi.y + tol
+                            || shi.y < lo.y - tol;
+                        !apart && c.cuts_segment(a, b, tol)
+                    })
             }
             _ => sampled,
         }
