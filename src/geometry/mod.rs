@@ -273,6 +273,12 @@ impl Shape2 {
                 }
                 let mut edges = 0;
                 for c in cutouts {
+                    // far from the cutout's box: neither in it nor on its edge
+                    let (lo, hi) = c.bounding_box();
+                    let m = tol.abs();
+                    if p.x < lo.x - m || p.x > hi.x + m || p.y < lo.y - m || p.y > hi.y + m {
+                        continue;
+                    }
                     let d = c.depth(p);
                     if d > tol {
                         return false;
@@ -332,7 +338,17 @@ impl Shape2 {
             (1..parts).all(|k| self.contains(&(a + (b - a) * (k as f64 / parts as f64)), tol));
         match self {
             Shape2::WithCutouts { cutouts, .. } => {
-                sampled && !cutouts.iter().any(|c| c.cuts_segment(a, b, tol))
+                let (slo, shi) = (a.inf(b), a.sup(b));
+                sampled
+                    && !cutouts.iter().any(|c| {
+                        let (lo, hi) = c.bounding_box();
+                        // boxes apart by more than tol: the bond misses the cutout
+                        let apart = slo.x > hi.x + tol
+                            || shi.x < lo.x - tol
+                            || slo.y > hi.y + tol
+                            || shi.y < lo.y - tol;
+                        !apart && c.cuts_segment(a, b, tol)
+                    })
             }
             _ => sampled,
         }
@@ -422,7 +438,7 @@ impl Shape2 {
 /// - Straight-edged outer: a disc wholly inside it is πr² (the cell's part of it,
 ///   [`convex_disc_area`]), else the outer polygon clipped by the cell, within the disc
 ///   (the signed triangle sum is exact for any polygon); a polygon cutout, part by convex
-///   part: the outer clipped by the part (clipped by the cell).
+///   part: the outer clipped by the part (and then by the cell).
 /// - Disc outer: each convex part (clipped by the cell) within the disc.
 /// - Dog-bone (its box less two discs): each convex part clipped by the box, less its parts
 ///   within the two discs.
@@ -469,6 +485,17 @@ pub fn cutout_area_in(outer: &Shape2, cutout: &Cutout, cell: Option<&[P]>) -> Op
             let outer_poly = outer.polygon();
             let mut sum = 0.0;
             for part in parts {
+                if let Some(poly) = &outer_poly {
+                    // clipped by the part, then by the cell: each clipper has the edges it
+                    // was given (the part clipped by the cell may have vertices that differ
+                    // by rounding only, whose edge has no direction to clip by)
+                    let mut q = clip_by_convex(poly, part);
+                    if let Some(cell) = cell {
+                        q = clip_by_convex(&q, cell);
+                    }
+                    sum += polygon_area(&q);
+                    continue;
+                }
                 let q = match cell {
                     Some(cell) => clip_by_convex(part, cell),
                     None => part.clone(),
@@ -476,12 +503,9 @@ pub fn cutout_area_in(outer: &Shape2, cutout: &Cutout, cell: Option<&[P]>) -> Op
                 if q.len() < 3 {
                     continue;
                 }
-                sum += match (outer, &outer_poly) {
-                    (_, Some(poly)) => polygon_area(&clip_by_convex(poly, &q)),
-                    (Shape2::Disc { centre, radius }, None) => {
-                        convex_disc_area(&q, centre, *radius)
-                    }
-                    (Shape2::DogBone { size }, None) => {
+                sum += match outer {
+                    Shape2::Disc { centre, radius } => convex_disc_area(&q, centre, *radius),
+                    Shape2::DogBone { size } => {
                         let d = *size;
                         let rect = [
                             P::new(-0.5 * d, 0.0),

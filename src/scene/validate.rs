@@ -468,16 +468,41 @@ impl Scene {
         }
         let outer = self.outer_shape();
         let size = outer.size();
+        // a cutout lies within a thousand times the body's size of it (beyond, its numbers
+        // would only lose the body's digits)
+        let reach = 1e3 * size;
+        let (lo, hi) = outer.bounding_box();
         let point = |key: &str, p: &[f64; 2]| -> Result<(), SceneError> {
-            finite(&format!("{key}[0]"), p[0])?;
-            finite(&format!("{key}[1]"), p[1])
+            for (c, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y)].into_iter().enumerate() {
+                let k = format!("{key}[{c}]");
+                finite(&k, p[c])?;
+                if p[c] < l - reach || p[c] > h + reach {
+                    return Err(invalid(
+                        k,
+                        p[c],
+                        format!("within 1000 × the body's size ({reach:.4e} m) of the body, [{:.4e}, {:.4e}] m", l - reach, h + reach),
+                    ));
+                }
+            }
+            Ok(())
+        };
+        let length = |key: String, v: f64| -> Result<(), SceneError> {
+            positive(&key, v)?;
+            if v > reach {
+                return Err(invalid(
+                    key,
+                    v,
+                    format!("at most 1000 × the body's size ({reach:.4e} m)"),
+                ));
+            }
+            Ok(())
         };
         for (i, c) in self.cutouts.iter().enumerate() {
             let key = format!("cutouts[{i}]");
             match c {
                 CutoutSpec::Disc { centre, diameter } => {
                     point(&format!("{key}.centre"), centre)?;
-                    positive(&format!("{key}.diameter"), *diameter)?;
+                    length(format!("{key}.diameter"), *diameter)?;
                 }
                 CutoutSpec::Polygon { vertices } => {
                     if vertices.len() < 3 {
@@ -519,11 +544,11 @@ impl Scene {
                             ),
                         ));
                     }
-                    if !(width.is_finite() && *width >= 0.0) {
+                    if !(width.is_finite() && *width >= 0.0 && *width <= reach) {
                         return Err(invalid(
                             format!("{key}.width"),
                             width,
-                            "a finite width >= 0 (0: a crack line, which removes no area, only the bonds that cross it)",
+                            format!("a width from 0 to 1000 × the body's size ({reach:.4e} m); 0 is a crack line, which removes no area, only the bonds that cross it"),
                         ));
                     }
                 }
@@ -534,8 +559,8 @@ impl Scene {
                     rotation_deg,
                 } => {
                     point(&format!("{key}.origin"), origin)?;
-                    positive(&format!("{key}.width"), *width)?;
-                    positive(&format!("{key}.height"), *height)?;
+                    length(format!("{key}.width"), *width)?;
+                    length(format!("{key}.height"), *height)?;
                     finite(&format!("{key}.rotation_deg"), *rotation_deg)?;
                 }
             }
@@ -614,7 +639,8 @@ impl Scene {
                 "cutouts",
                 format!("{} cutouts", cutouts.len()),
                 format!(
-                    "cutouts that leave some of the body; these remove all of it ({outer_area:.4e} m²)"
+                    "cutouts that leave some of the body; cutouts[0] to cutouts[{}] together remove all of it ({outer_area:.4e} m²)",
+                    cutouts.len() - 1
                 ),
             ));
         }

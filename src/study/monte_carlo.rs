@@ -441,6 +441,12 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
                     body_name(&base.body)
                 );
             }
+            if !base.cutouts.is_empty() {
+                bail!(
+                    "--sizes scales the dog-bone (body.size) but not its {} [[cutouts]]; leave --sizes out to run the scene's own size",
+                    base.cutouts.len()
+                );
+            }
             s.clone()
         }
         None => vec![nominal_size(&base).0],
