@@ -11,18 +11,22 @@ const L0: f64 = 0.001;
 /// Offsets (in spacings): the origin and two fixed "random" ones.
 const OFFSETS: [[f64; 2]; 3] = [[0.0, 0.0], [0.37, 0.61], [0.83, 0.12]];
 
+fn placement(rotation_deg: f64, offset: [f64; 2], surface: &'static str) -> Placement {
+    Placement {
+        spacing: L0,
+        rotation_deg,
+        offset: [offset[0] * L0, offset[1] * L0],
+        surface,
+    }
+}
+
 fn main() {
     println!("# plate with a hole, W = 20·R, uniaxial tension, recovered stress / remote: hoop stress at the hole's sides (Howland 3.03), largest |σ_rr| and |σ_rθ| on the hole's edge");
     println!("| R/L0 | rotation | hoop | max σ_rr | max σ_rθ |");
     println!("|---|---|---|---|---|");
     for r in [10.0, 20.0] {
         for rot in [0.0, 30.0] {
-            let p = Placement {
-                spacing: L0,
-                rotation_deg: rot,
-                offset: [0.0, 0.0],
-                surface: "voronoi_fit",
-            };
+            let p = placement(rot, [0.0, 0.0], "voronoi_fit");
             let s = hole_stress(20.0 * r * L0, r * L0, &p).expect("plate with a hole");
             println!(
                 "| {r} | {rot}° | {:.3} | {:.3} | {:.3} |",
@@ -39,12 +43,7 @@ fn main() {
             let cells: Vec<String> = METHODS
                 .iter()
                 .map(|&surface| {
-                    let p = Placement {
-                        spacing: L0,
-                        rotation_deg: rot,
-                        offset: [0.0, 0.0],
-                        surface,
-                    };
+                    let p = placement(rot, [0.0, 0.0], surface);
                     let (e, nu) = plate_modulus(w * L0, 2.0 * w * L0, &p).expect("plate");
                     format!("{:+.2} / {:+.2}", (e - 1.0) * 100.0, (nu - 1.0) * 100.0)
                 })
@@ -62,12 +61,7 @@ fn main() {
                 let cells: Vec<String> = METHODS
                     .iter()
                     .map(|&surface| {
-                        let p = Placement {
-                            spacing: L0,
-                            rotation_deg: rot,
-                            offset: [off[0] * L0, off[1] * L0],
-                            surface,
-                        };
+                        let p = placement(rot, off, surface);
                         let (k, model) =
                             cantilever_stiffness(h * L0, 10.0 * h * L0, &p).expect("cantilever");
                         let mass: f64 = model.mech.mass.iter().sum();

@@ -198,3 +198,29 @@ fn free_faces_carry_no_normal_traction_and_the_far_field_tangential_stress() {
         }
     }
 }
+
+/// A body and lattice symmetric about x = 0 (the split cylinder at 0°) get mirror-image
+/// volumes and micro-moduli, bit for bit, so that a symmetric specimen cracks symmetrically
+/// (tests/specimens.rs).
+#[test]
+fn mirror_images_get_the_same_cells_and_moduli() {
+    let text = std::fs::read_to_string("lattices/split_cylinder.toml").unwrap();
+    let model = prepare_model(&Scene::from_toml_str(&text, &[]).unwrap()).unwrap();
+    let p = &model.particles;
+    let key = |x: f64, y: f64| ((x * 1e9).round() as i64, (y * 1e9).round() as i64);
+    let index: std::collections::HashMap<(i64, i64), usize> = (0..p.len())
+        .map(|i| (key(p.x0[i].x, p.x0[i].y), i))
+        .collect();
+    let mut worst = (0.0f64, 0.0f64, 0.0f64);
+    for i in 0..p.len() {
+        let j = index[&key(-p.x0[i].x, p.x0[i].y)];
+        worst.0 = worst.0.max((p.volume[i] - p.volume[j]).abs() / p.volume[i]);
+        worst.1 = worst.1.max((p.a[i] - p.a[j]).abs() / p.a[i].abs());
+        worst.2 = worst.2.max((p.b[i] - p.b[j]).abs() / p.b[i].abs());
+    }
+    println!(
+        "mirror differences: volume {:.1e}, a {:.1e}, b {:.1e}",
+        worst.0, worst.1, worst.2
+    );
+    assert_eq!(worst, (0.0, 0.0, 0.0));
+}

@@ -374,37 +374,14 @@ pub fn static_response<const D: usize, const K: usize>(
     constrained: &[[bool; D]],
     prescribed: &[SVector<f64, D>],
 ) -> Result<Field<D>, ModalError> {
-    let n = x0.len();
-    let modes = mechanisms(x0, &mech.mass, constrained);
-    let mut op = LinearOperator::new(mech, x0);
-    // rhs = −K ū on the free components
-    let mut ku: Field<D> = vec![SVector::zeros(); n];
-    op.internal_forces(prescribed, &mut ku);
-    let rhs: Field<D> = ku; // f(ū) = −K ū
-    let mut rhs = rhs;
-    mask(&mut rhs, constrained);
-    let mut z: Field<D> = vec![SVector::zeros(); n];
-    let mut w = CgWork::new(n);
-    conjugate_gradient(
-        &mut op,
-        constrained,
-        &modes,
-        &mech.mass,
-        &rhs,
-        &mut z,
-        1e-12,
-        &mut w,
-    )?;
-    Ok((0..n)
-        .map(|i| {
-            let mut u = z[i];
-            for d in 0..D {
-                if constrained[i][d] {
-                    u[d] = prescribed[i][d];
-                }
-            }
-            u
-        })
+    // rhs = f(ū) = −K ū on the free components
+    let mut rhs: Field<D> = vec![SVector::zeros(); x0.len()];
+    LinearOperator::new(mech, x0).internal_forces(prescribed, &mut rhs);
+    let z = static_force_response(mech, x0, constrained, &rhs)?;
+    Ok(z.iter()
+        .zip(prescribed)
+        .zip(constrained)
+        .map(|((z, p), c)| SVector::from_fn(|d, _| if c[d] { p[d] } else { z[d] }))
         .collect())
 }
 

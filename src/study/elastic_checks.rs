@@ -98,22 +98,8 @@ pub fn plate_scene(width: f64, height: f64, p: &Placement) -> Result<Scene, RunE
 /// displacements over the middle half of the plate.
 pub fn plate_modulus(width: f64, height: f64, p: &Placement) -> Result<(f64, f64), RunError> {
     let model = prepare_model(&plate_scene(width, height, p)?)?;
-    let n = model.particles.len();
-    let mut ubar = vec![Vector2::zeros(); n];
-    for pr in &model.prescribed {
-        ubar[pr.particle as usize][pr.component as usize] = pr.amplitude;
-    }
+    let (u, force) = pulled(&model)?;
     let x0 = &model.particles.x0;
-    let u = static_response(&model.mech, x0, &model.constrained, &ubar)?;
-    let mut op = LinearOperator::new(&model.mech, x0);
-    let mut f = vec![Vector2::zeros(); n];
-    op.internal_forces(&u, &mut f);
-    let top = model
-        .groups
-        .iter()
-        .find(|g| g.name == "top")
-        .expect("group");
-    let force = -top.members.iter().map(|&i| f[i as usize].y).sum::<f64>();
     // affine fit u ≈ G·x + c over the middle half
     let (cx, cy) = (0.5 * width, 0.5 * height);
     let mut ata = Matrix3::zeros();
@@ -130,6 +116,27 @@ pub fn plate_modulus(width: f64, height: f64, p: &Placement) -> Result<(f64, f64
     let (exx, eyy) = ((inv * atb[0])[0], (inv * atb[1])[1]);
     let sigma = force / (width * THICKNESS);
     Ok((sigma / eyy / E, -exx / eyy / NU))
+}
+
+/// The static displacements of a model at its full prescribed displacements, and the
+/// reaction (along y) of its group "top".
+fn pulled(model: &Model) -> Result<(Vec<Vector2<f64>>, f64), RunError> {
+    let n = model.particles.len();
+    let mut ubar = vec![Vector2::zeros(); n];
+    for pr in &model.prescribed {
+        ubar[pr.particle as usize][pr.component as usize] = pr.amplitude;
+    }
+    let x0 = &model.particles.x0;
+    let u = static_response(&model.mech, x0, &model.constrained, &ubar)?;
+    let mut f = vec![Vector2::zeros(); n];
+    LinearOperator::new(&model.mech, x0).internal_forces(&u, &mut f);
+    let top = model
+        .groups
+        .iter()
+        .find(|g| g.name == "top")
+        .expect("group");
+    let force = -top.members.iter().map(|&i| f[i as usize].y).sum::<f64>();
+    Ok((u, force))
 }
 
 /// A square plate of side `width` with a central circular hole of radius `radius`, held and
@@ -165,21 +172,9 @@ pub fn hole_stress(width: f64, radius: f64, p: &Placement) -> Result<HoleStress,
     use crate::run::stress_recovery::elastic_stress;
     let model = prepare_model(&hole_plate_scene(width, radius, p)?)?;
     let n = model.particles.len();
-    let mut ubar = vec![Vector2::zeros(); n];
-    for pr in &model.prescribed {
-        ubar[pr.particle as usize][pr.component as usize] = pr.amplitude;
-    }
+    let (u, force) = pulled(&model)?;
+    let remote = force / (width * THICKNESS);
     let x0 = &model.particles.x0;
-    let u = static_response(&model.mech, x0, &model.constrained, &ubar)?;
-    let mut op = LinearOperator::new(&model.mech, x0);
-    let mut f = vec![Vector2::zeros(); n];
-    op.internal_forces(&u, &mut f);
-    let top = model
-        .groups
-        .iter()
-        .find(|g| g.name == "top")
-        .expect("group");
-    let remote = -top.members.iter().map(|&i| f[i as usize].y).sum::<f64>() / (width * THICKNESS);
     let x: Vec<Vector2<f64>> = x0.iter().zip(&u).map(|(a, b)| a + b).collect();
     let sigma = elastic_stress(&model, &x);
     let c = Vector2::new(0.5 * width, 0.5 * width);
