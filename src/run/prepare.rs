@@ -500,9 +500,8 @@ pub fn fit_moduli<const K: usize>(
         );
         match fit {
             Some(f) => {
-                let scale = a[i];
-                a[i] = quantised(f.moduli.a, scale);
-                b[i] = quantised(f.moduli.b, scale);
+                a[i] = f.moduli.a;
+                b[i] = f.moduli.b;
                 residual[i] = f.residual;
             }
             None => unfitted += 1,
