@@ -24,10 +24,16 @@ fn plate(overrides: &[&str]) -> Scene {
 }
 
 /// The Table 1 tension block (150 × 300 mm) at L0 = 12.5 mm, loaded to 1.5·COD_c.
+/// The tension block on the source's lattice surface: with clipped Voronoi cells (issue 14)
+/// its peak depends on Δt ten times more (0.9× against 0.5× the limit: −4.9e-3 with
+/// `voronoi_fit`, +2.6e-3 with `voronoi`, −4.0e-4 on the source's surface; 0.7× lies
+/// between), which is recorded in benchmarks/RESULTS.md ("Surfaces") and left open there;
+/// this test keeps checking the integrator on the surface it was written for.
 fn block(overrides: &[&str]) -> Scene {
     let mut o: Vec<String> = vec![
         "discretisation.spacing=0.0125".into(),
         "loading.end_periods=20".into(),
+        "discretisation.surface=\"lattice\"".into(),
     ];
     o.extend(overrides.iter().map(|s| s.to_string()));
     Scene::from_file(std::path::Path::new("lattices/uniaxial_tension.toml"), &o).unwrap()
