@@ -16,7 +16,9 @@
 
 pub use crate::geometry::polygon::convex_disc_area;
 use crate::geometry::polygon::{clip_by_convex, clip_half_plane, half_planes};
-use crate::geometry::{cutout_area_in_or_chords, dogbone_arcs, points_box, polygon_area, Shape2};
+use crate::geometry::{
+    cutout_area_in_or_chords, dogbone_area_of_convex, points_box, polygon_area, Shape2,
+};
 use nalgebra::Vector2;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
@@ -35,35 +37,7 @@ pub fn area_in_body(cell: &[P], shape: &Shape2) -> f64 {
                 convex_disc_area(cell, centre, *radius)
             }
         }
-        Shape2::DogBone { size } => {
-            // the dog-bone is its bounding rectangle less two discs (geometry::dogbone_half_width)
-            let d = *size;
-            let rect = [
-                P::new(-0.5 * d, 0.0),
-                P::new(0.5 * d, 0.0),
-                P::new(0.5 * d, 1.5 * d),
-                P::new(-0.5 * d, 1.5 * d),
-            ];
-            let c = clip_by_convex(cell, &rect);
-            if c.len() < 3 {
-                return 0.0;
-            }
-            let (r, centres) = dogbone_arcs(d);
-            let mut area = polygon_area(&c);
-            // only cells whose box meets a disc's box (disjoint cells would add a
-            // rounding-size zero)
-            let (lo, hi) = points_box(&c);
-            for centre in centres {
-                if lo.x < centre.x + r
-                    && hi.x > centre.x - r
-                    && lo.y < centre.y + r
-                    && hi.y > centre.y - r
-                {
-                    area -= convex_disc_area(&c, &centre, r);
-                }
-            }
-            area
-        }
+        Shape2::DogBone { size } => dogbone_area_of_convex(cell, *size),
         Shape2::WithCutouts { outer, cutouts } => {
             let cell = &without_near_duplicates(cell);
             let mut area = area_in_body(cell, outer);

@@ -505,25 +505,7 @@ pub fn cutout_area_in(outer: &Shape2, cutout: &Cutout, cell: Option<&[P]>) -> Op
                 }
                 sum += match outer {
                     Shape2::Disc { centre, radius } => convex_disc_area(&q, centre, *radius),
-                    Shape2::DogBone { size } => {
-                        let d = *size;
-                        let rect = [
-                            P::new(-0.5 * d, 0.0),
-                            P::new(0.5 * d, 0.0),
-                            P::new(0.5 * d, 1.5 * d),
-                            P::new(-0.5 * d, 1.5 * d),
-                        ];
-                        let c = clip_by_convex(&q, &rect);
-                        if c.len() < 3 {
-                            continue;
-                        }
-                        let (ra, arcs) = dogbone_arcs(d);
-                        polygon_area(&c)
-                            - arcs
-                                .iter()
-                                .map(|a| convex_disc_area(&c, a, ra))
-                                .sum::<f64>()
-                    }
+                    Shape2::DogBone { size } => dogbone_area_of_convex(&q, *size),
                     _ => return None,
                 };
             }
@@ -559,6 +541,32 @@ pub fn dogbone_arcs(d: f64) -> (f64, [Vector2<f64>; 2]) {
             Vector2::new(1.025 * d, 0.75 * d),
         ],
     )
+}
+
+/// Area of a convex polygon (counter-clockwise) within the dog-bone of size `d`: its part in
+/// the bounding rectangle less its parts in the two discs of [`dogbone_arcs`] (a disc whose
+/// box misses the part's is skipped, so that it adds no rounding-size zero).
+pub fn dogbone_area_of_convex(poly: &[Vector2<f64>], d: f64) -> f64 {
+    let rect = [
+        Vector2::new(-0.5 * d, 0.0),
+        Vector2::new(0.5 * d, 0.0),
+        Vector2::new(0.5 * d, 1.5 * d),
+        Vector2::new(-0.5 * d, 1.5 * d),
+    ];
+    let c = clip_by_convex(poly, &rect);
+    if c.len() < 3 {
+        return 0.0;
+    }
+    let (r, centres) = dogbone_arcs(d);
+    let mut area = polygon_area(&c);
+    let (lo, hi) = points_box(&c);
+    for centre in centres {
+        if lo.x < centre.x + r && hi.x > centre.x - r && lo.y < centre.y + r && hi.y > centre.y - r
+        {
+            area -= convex_disc_area(&c, &centre, r);
+        }
+    }
+    area
 }
 
 /// Half-width of the dog-bone of size `d` at height `y` (0 ≤ y ≤ 1.5·d).

@@ -314,6 +314,7 @@ fn assemble<const K: usize>(
         stage("boundary particles: clipped Voronoi cells and fitted moduli");
         surface_treatment(
             &mut particles,
+            m.thickness,
             &shape,
             method,
             &dmat,
@@ -399,6 +400,7 @@ fn assemble<const K: usize>(
 #[allow(clippy::too_many_arguments)]
 fn surface_treatment<const K: usize>(
     particles: &mut Particles<2, K>,
+    thickness: f64,
     shape: &crate::geometry::Shape2,
     method: Surface,
     dmat: &nalgebra::Matrix3<f64>,
@@ -407,7 +409,6 @@ fn surface_treatment<const K: usize>(
     report: &mut SurfaceCorrection,
 ) -> Result<(), RunError> {
     let n = particles.len();
-    let thickness = particles.volume[0] / (0.5 * 3f64.sqrt() * particles.spacing.powi(2));
     let clipped = match method {
         Surface::VoronoiFit | Surface::Voronoi => Some(
             voronoi::clipped_cells(&particles.x0, shape).map_err(|e| {
