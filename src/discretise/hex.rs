@@ -122,7 +122,7 @@ impl HexLattice {
 }
 
 /// Remove particles with no bond, renumbering the neighbour slots.
-fn drop_isolated<const D: usize, const K: usize>(p: &mut Particles<D, K>) {
+pub(crate) fn drop_isolated<const D: usize, const K: usize>(p: &mut Particles<D, K>) {
     let keep: Vec<bool> = p
         .neighbours
         .iter()

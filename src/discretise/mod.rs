@@ -10,11 +10,13 @@
 //! own values from the body, never the scene's nominal spacing.
 
 pub mod csr;
+pub mod fcc;
 pub mod groups;
 pub mod hex;
 pub mod random;
 pub mod voronoi;
 
+pub(crate) use hex::drop_isolated;
 use nalgebra::SVector;
 
 /// Sentinel of an empty neighbour slot.

@@ -9,9 +9,11 @@
 
 mod cutout;
 pub mod polygon;
+pub mod solid;
 
 pub use cutout::Cutout;
 pub use polygon::{points_box, polygon_area, Piece};
+pub use solid::Shape3;
 
 use nalgebra::Vector2;
 use polygon::{clip_by_convex, convex_disc_area, distance_to_polygon, point_in_polygon};

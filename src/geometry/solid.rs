@@ -1,0 +1,186 @@
+//! 3D specimen bodies (issue "3D"): a box, a cylinder about any axis, and any 2D shape
+//! extruded through a thickness along z (so the dog-bone, the notched beam and every body
+//! with cutouts come as prisms). They answer what the FCC lattice asks of a body: a bounding
+//! box, a point test with a tolerance, whether a bond stays in the body, and the volume.
+
+use super::Shape2;
+use nalgebra::{Vector2, Vector3};
+
+/// A 3D specimen shape.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape3 {
+    /// Axis-aligned box `[origin, origin + size]`.
+    Box {
+        origin: Vector3<f64>,
+        size: Vector3<f64>,
+    },
+    /// Circular cylinder: base centre, unit axis, radius, length along the axis.
+    Cylinder {
+        base: Vector3<f64>,
+        axis: Vector3<f64>,
+        radius: f64,
+        length: f64,
+    },
+    /// A 2D section (x, y) extruded through z ∈ [0, thickness].
+    Extruded { section: Shape2, thickness: f64 },
+}
+
+/// Two unit vectors completing the unit vector `a` to an orthonormal frame.
+fn frame(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if a.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let u = a.cross(&helper).normalize();
+    (u, a.cross(&u))
+}
+
+impl Shape3 {
+    /// Lower and upper corners of the axis-aligned bounding box.
+    pub fn bounding_box(&self) -> (Vector3<f64>, Vector3<f64>) {
+        match self {
+            Shape3::Box { origin, size } => (*origin, origin + size),
+            Shape3::Cylinder {
+                base,
+                axis,
+                radius,
+                length,
+            } => {
+                let top = base + axis * *length;
+                // a disc of radius r normal to a reaches r·√(1 − a_d²) along axis d
+                let reach =
+                    Vector3::from_fn(|d, _| radius * (1.0 - axis[d] * axis[d]).max(0.0).sqrt());
+                (base.inf(&top) - reach, base.sup(&top) + reach)
+            }
+            Shape3::Extruded { section, thickness } => {
+                let (lo, hi) = section.bounding_box();
+                (
+                    Vector3::new(lo.x, lo.y, 0.0),
+                    Vector3::new(hi.x, hi.y, *thickness),
+                )
+            }
+        }
+    }
+
+    /// The largest extent of the bounding box.
+    pub fn size(&self) -> f64 {
+        let (lo, hi) = self.bounding_box();
+        (hi - lo).max()
+    }
+
+    /// Volume (m³).
+    pub fn volume(&self) -> f64 {
+        match self {
+            Shape3::Box { size, .. } => size.x * size.y * size.z,
+            Shape3::Cylinder { radius, length, .. } => {
+                std::f64::consts::PI * radius * radius * length
+            }
+            Shape3::Extruded { section, thickness } => section.area() * thickness,
+        }
+    }
+
+    /// Whether `p` lies in the body or within `tol` of it.
+    pub fn contains(&self, p: &Vector3<f64>, tol: f64) -> bool {
+        match self {
+            Shape3::Box { origin, size } => {
+                (0..3).all(|d| p[d] >= origin[d] - tol && p[d] <= origin[d] + size[d] + tol)
+            }
+            Shape3::Cylinder {
+                base,
+                axis,
+                radius,
+                length,
+            } => {
+                let r = p - base;
+                let h = r.dot(axis);
+                h >= -tol && h <= length + tol && (r - axis * h).norm() <= radius + tol
+            }
+            Shape3::Extruded { section, thickness } => {
+                p.z >= -tol
+                    && p.z <= thickness + tol
+                    && section.contains(&Vector2::new(p.x, p.y), tol)
+            }
+        }
+    }
+
+    /// Whether the bond from `a` to `b` (both in the body) stays in it: always for the convex
+    /// box and cylinder; for a prism, the section's test of the bond's projection
+    /// ([`Shape2::segment_in_body`], `parts` as there: the outline at the interior
+    /// `parts`-th points, every cutout exactly).
+    pub fn segment_in_body(
+        &self,
+        a: &Vector3<f64>,
+        b: &Vector3<f64>,
+        tol: f64,
+        parts: usize,
+    ) -> bool {
+        match self {
+            Shape3::Box { .. } | Shape3::Cylinder { .. } => true,
+            Shape3::Extruded { section, .. } => {
+                let (pa, pb) = (Vector2::new(a.x, a.y), Vector2::new(b.x, b.y));
+                (pa - pb).norm() <= tol || section.segment_in_body(&pa, &pb, tol, parts)
+            }
+        }
+    }
+
+    /// A cylinder's frame: two unit vectors normal to its axis and to each other (to place
+    /// strips along its generatrix); `None` for the other shapes.
+    pub fn cylinder_frame(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        match self {
+            Shape3::Cylinder { axis, .. } => Some(frame(axis)),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn volumes_and_point_tests() {
+        let b = Shape3::Box {
+            origin: Vector3::new(1.0, 2.0, 3.0),
+            size: Vector3::new(2.0, 3.0, 4.0),
+        };
+        assert_relative_eq!(b.volume(), 24.0);
+        assert!(b.contains(&Vector3::new(3.0, 5.0, 7.0), 1e-12));
+        assert!(!b.contains(&Vector3::new(3.1, 5.0, 7.0), 1e-12));
+        let axis = Vector3::new(1.0, 1.0, 0.0).normalize();
+        let c = Shape3::Cylinder {
+            base: Vector3::zeros(),
+            axis,
+            radius: 0.5,
+            length: 2.0,
+        };
+        assert_relative_eq!(c.volume(), std::f64::consts::PI * 0.5);
+        let (u, v) = c.cylinder_frame().unwrap();
+        assert_relative_eq!(u.dot(&axis), 0.0, epsilon = 1e-15);
+        assert_relative_eq!(v.dot(&u), 0.0, epsilon = 1e-15);
+        let mid = axis * 1.0;
+        assert!(c.contains(&(mid + u * 0.499), 0.0));
+        assert!(!c.contains(&(mid + v * 0.501), 0.0));
+        assert!(!c.contains(&(axis * 2.01), 0.0));
+        // the bounding box holds the rim points
+        let (lo, hi) = c.bounding_box();
+        for k in 0..64 {
+            let t = k as f64 / 64.0 * std::f64::consts::TAU;
+            for h in [0.0, 2.0] {
+                let p = axis * h + (u * t.cos() + v * t.sin()) * 0.5;
+                assert!((0..3).all(|d| p[d] >= lo[d] - 1e-12 && p[d] <= hi[d] + 1e-12));
+            }
+        }
+        let e = Shape3::Extruded {
+            section: Shape2::Disc {
+                centre: Vector2::zeros(),
+                radius: 1.0,
+            },
+            thickness: 0.5,
+        };
+        assert_relative_eq!(e.volume(), 0.5 * std::f64::consts::PI, max_relative = 1e-12);
+        assert!(e.contains(&Vector3::new(0.0, 0.99, 0.25), 0.0));
+        assert!(!e.contains(&Vector3::new(0.0, 0.99, 0.51), 0.0));
+    }
+}
