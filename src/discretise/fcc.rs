@@ -154,7 +154,8 @@ impl FccLattice {
 /// How the micro-moduli of an FCC body were set ([`assign_moduli`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ModuliReport {
-    /// Particles with all 18 bonds: the bulk constants (4.8) with the erratum.
+    /// Particles with all 18 bonds: the bulk constants (4.8) with the erratum (× the volume
+    /// fraction of a clipped cell).
     pub bulk: usize,
     /// Particles with missing bonds fitted (a, b, c) against D (3.20).
     pub fitted: usize,
@@ -167,7 +168,9 @@ pub struct ModuliReport {
 }
 
 /// Set a, b, c of every particle of an FCC body for the isotropic (E, ν) (MODEL.md §3 with
-/// its erratum): the bulk constants [`fcc`] for a particle with all 18 bonds; for one with
+/// its erratum) and its volume `p.volume` (the full cell, or the cell clipped to the body,
+/// `voronoi3::fcc_clipped_volumes`): the bulk constants [`fcc`] scaled by the particle's
+/// volume fraction for a particle with all 18 bonds; for one with
 /// missing bonds the least-squares (a, b, c) of its own bonds and volume against D (3.20,
 /// [`fit_fcc`]), or (a, b) with c = 0 where that fit fails, or the bulk constants where no
 /// fit exists.
@@ -178,6 +181,12 @@ pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliRepo
         let bulk = fcc(e, nu, p.length[i]);
         let (mut a, mut b, mut c) = (bulk.a, bulk.b, bulk.c);
         if p.bond_count(i) == SLOTS {
+            // a clipped cell with every bond: the fit is the bulk constants × the volume
+            // fraction exactly (D_i is linear in 1/ΔV_i)
+            let fraction = p.volume[i] / fcc_volume(p.length[i]);
+            if fraction != 1.0 {
+                (a, b, c) = (a * fraction, b * fraction, c * fraction);
+            }
             report.bulk += 1;
         } else {
             let bonds: Vec<FccBond> = (0..SLOTS)

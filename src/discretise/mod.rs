@@ -15,6 +15,7 @@ pub mod groups;
 pub mod hex;
 pub mod random;
 pub mod voronoi;
+pub mod voronoi3;
 
 pub(crate) use hex::drop_isolated;
 use nalgebra::SVector;

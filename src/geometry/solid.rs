@@ -124,6 +124,22 @@ impl Shape3 {
         }
     }
 
+    /// The body as half-spaces n·x ≤ c (n outward unit normals) where it is a convex
+    /// polyhedron (the box); `None` otherwise.
+    pub fn planes(&self) -> Option<Vec<(Vector3<f64>, f64)>> {
+        match self {
+            Shape3::Box { origin, size } => Some(
+                (0..3)
+                    .flat_map(|d| {
+                        let e = Vector3::from_fn(|k, _| if k == d { 1.0 } else { 0.0 });
+                        [(e, origin[d] + size[d]), (-e, -origin[d])]
+                    })
+                    .collect(),
+            ),
+            _ => None,
+        }
+    }
+
     /// A cylinder's frame: two unit vectors normal to its axis and to each other (to place
     /// strips along its generatrix); `None` for the other shapes.
     pub fn cylinder_frame(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {

@@ -206,3 +206,78 @@ pub fn hole_stress(width: f64, radius: f64, p: &Placement) -> Result<HoleStress,
         max_shear,
     })
 }
+
+/// (E/E_input, ν/ν_input) of an FCC block W × W × H (H along z; W = `width`) in uniaxial
+/// tension, measured as on a testing machine: the particles within 1.5·L0 of the bottom
+/// face held in z, those within 1.5·L0 of the top face pulled 1e-4·H in z, the side faces
+/// free; σ = F/W² from the reaction of the pulled particles, ε_zz and the lateral strains
+/// (mean of ε_xx and ε_yy) from an affine fit of the displacements over the middle half of
+/// the block. `surface` as `discretisation.surface`: "voronoi_fit" (cells clipped to the
+/// body, boundary moduli fitted), "lattice_fit" (full cells, boundary moduli fitted) or
+/// "lattice" (full cells, the bulk constants everywhere: the source).
+pub fn fcc_block_modulus(
+    width: f64,
+    height: f64,
+    lattice: &crate::discretise::fcc::FccLattice,
+    surface: &str,
+) -> Result<(f64, f64), RunError> {
+    use crate::discretise::fcc::assign_moduli;
+    use crate::geometry::Shape3;
+    use crate::model::micro_modulus::fcc;
+    use crate::solver::mechanics::Mechanics;
+    use nalgebra::{SMatrix, SVector};
+    let shape = Shape3::Box {
+        origin: Vector3::zeros(),
+        size: Vector3::new(width, width, height),
+    };
+    let mut p = lattice.fill(&shape);
+    let n = p.len();
+    if surface == "voronoi_fit" {
+        p.volume = crate::discretise::voronoi3::fcc_clipped_volumes(&p, &shape)
+            .expect("a box is a convex polyhedron");
+    }
+    assign_moduli(&mut p, E, NU);
+    if surface == "lattice" {
+        let m = fcc(E, NU, lattice.spacing);
+        (p.a, p.b, p.c) = (vec![m.a; n], vec![m.b; n], vec![m.c; n]);
+    }
+    let mech = Mechanics::new(&p, &vec![2400.0; n]);
+    let band = 1.5 * lattice.spacing;
+    let strain = 1e-4;
+    let mut constrained = vec![[false; 3]; n];
+    let mut ubar = vec![Vector3::zeros(); n];
+    let mut top = Vec::new();
+    for i in 0..n {
+        let z = p.x0[i].z;
+        if z < band {
+            constrained[i][2] = true;
+        } else if z > height - band {
+            constrained[i][2] = true;
+            ubar[i].z = strain * height;
+            top.push(i);
+        }
+    }
+    let u = static_response(&mech, &p.x0, &constrained, &ubar)?;
+    let mut f = vec![Vector3::zeros(); n];
+    LinearOperator::new(&mech, &p.x0).internal_forces(&u, &mut f);
+    let force = -top.iter().map(|&i| f[i].z).sum::<f64>();
+    // affine fit u ≈ G·x + c over the middle half
+    let mut ata = SMatrix::<f64, 4, 4>::zeros();
+    let mut atb = [SVector::<f64, 4>::zeros(); 3];
+    for (x, ui) in p.x0.iter().zip(&u) {
+        let inside = (x.x - 0.5 * width).abs() <= 0.25 * width
+            && (x.y - 0.5 * width).abs() <= 0.25 * width
+            && (x.z - 0.5 * height).abs() <= 0.25 * height;
+        if inside {
+            let row = SVector::<f64, 4>::new(x.x, x.y, x.z, 1.0);
+            ata += row * row.transpose();
+            for d in 0..3 {
+                atb[d] += row * ui[d];
+            }
+        }
+    }
+    let inv = ata.try_inverse().expect("the middle half holds particles");
+    let (exx, eyy, ezz) = ((inv * atb[0])[0], (inv * atb[1])[1], (inv * atb[2])[2]);
+    let sigma = force / (width * width);
+    Ok((sigma / ezz / E, -0.5 * (exx + eyy) / ezz / NU))
+}
