@@ -48,7 +48,7 @@ fn every_shipped_body_carries_its_mass_at_any_rotation_and_offset() {
                 let scene = Scene::from_toml_str(&text, &sets).unwrap();
                 let model = prepare_model(&scene).unwrap();
                 let m = &scene.material;
-                let want = m.rho * scene.shape().area() * m.thickness;
+                let want = m.rho * scene.shape().area() * m.thickness();
                 let got: f64 = model.mech.mass.iter().sum();
                 assert!(
                     (got / want - 1.0).abs() < 1e-9,

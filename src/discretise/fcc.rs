@@ -152,7 +152,7 @@ impl FccLattice {
 }
 
 /// How the micro-moduli of an FCC body were set ([`assign_moduli`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct ModuliReport {
     /// Particles with all 18 bonds: the bulk constants (4.8) with the erratum (× the volume
     /// fraction of a clipped cell).
@@ -161,7 +161,8 @@ pub struct ModuliReport {
     pub fitted: usize,
     /// Particles with missing bonds whose (a, b, c) fit failed, fitted (a, b) with c = 0.
     pub fitted_without_c: usize,
-    /// Particles no fit could serve (too few or coplanar bonds), given the bulk constants.
+    /// Particles no fit could serve (too few or coplanar bonds), given the bulk constants
+    /// scaled by their volume fraction.
     pub unfitted: usize,
     /// Largest relative residual ‖D_i − D‖/‖D‖ of a fitted particle.
     pub max_residual: f64,
@@ -173,7 +174,7 @@ pub struct ModuliReport {
 /// volume fraction for a particle with all 18 bonds; for one with
 /// missing bonds the least-squares (a, b, c) of its own bonds and volume against D (3.20,
 /// [`fit_fcc`]), or (a, b) with c = 0 where that fit fails, or the bulk constants where no
-/// fit exists.
+/// fit exists (scaled by the volume fraction).
 pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliReport {
     let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
     let mut report = ModuliReport::default();
@@ -207,6 +208,9 @@ pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliRepo
                     report.fitted_without_c += 1;
                     report.max_residual = report.max_residual.max(f.residual);
                 } else {
+                    // the bulk constants for the particle's own (possibly clipped) volume
+                    let fraction = p.volume[i] / fcc_volume(p.length[i]);
+                    (a, b, c) = (a * fraction, b * fraction, c * fraction);
                     report.unfitted += 1;
                 }
             }

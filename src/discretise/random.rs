@@ -72,8 +72,8 @@ impl RandomParticles {
             spacing: d.spacing,
             min_distance: d.min_distance.unwrap_or(DEFAULT_MIN_DISTANCE),
             seed: scene.seed.unwrap_or(crate::scene::DEFAULT_SEED),
-            rotation_deg: d.rotation_deg,
-            thickness: scene.material.thickness,
+            rotation_deg: d.rotation_deg.angle(),
+            thickness: scene.material.thickness(),
         }
     }
 }

@@ -87,7 +87,7 @@ impl ConcreteLaw {
         Some(ConcreteLaw {
             e: scene.material.youngs_modulus(),
             nu: scene.material.nu,
-            plane: scene.material.plane,
+            plane: scene.material.plane(),
             fc: get("fc"),
             ft: get("ft"),
             fy: get("fy"),

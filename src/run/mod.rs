@@ -12,6 +12,7 @@
 
 pub mod execute;
 pub mod prepare;
+pub mod solid;
 pub mod stress_recovery;
 pub mod summary;
 

@@ -74,14 +74,21 @@ pub struct Prepared<const K: usize = 6> {
     pub probe: Option<(String, Probe)>,
 }
 
-/// Particles the body will hold (area / cell area), known before anything is allocated.
+/// Particles the body will hold (area / cell area; in 3D volume / cell volume), known
+/// before anything is allocated.
 pub fn estimated_particles(scene: &Scene) -> f64 {
+    if let Some(solid) = scene.solid() {
+        return super::solid::estimated_particles(scene, &solid);
+    }
     let l0 = scene.discretisation.spacing;
     scene.shape().area() / (0.5 * 3f64.sqrt() * l0 * l0)
 }
 
 /// Estimated bytes a run allocates.
 pub fn estimated_memory(scene: &Scene) -> f64 {
+    if let Some(solid) = scene.solid() {
+        return super::solid::estimated_memory(scene, &solid);
+    }
     estimated_particles(scene) * bytes_per_particle(2, slots_of(scene)) as f64
 }
 
@@ -164,9 +171,9 @@ fn discretise<const K: usize>(
     }
     let lattice = HexLattice {
         spacing: d.spacing,
-        rotation_deg: d.rotation_deg,
-        offset: Vector2::new(d.offset[0], d.offset[1]),
-        thickness: scene.material.thickness,
+        rotation_deg: d.rotation_deg.angle(),
+        offset: Vector2::from(d.offset2()),
+        thickness: scene.material.thickness(),
     };
     Ok((lattice.fill_slots(shape), None))
 }
@@ -188,6 +195,12 @@ fn assemble<const K: usize>(
 ) -> Result<Model<K>, RunError> {
     let d = &scene.discretisation;
     let m = &scene.material;
+    if d.dim() == 3 {
+        return Err(RunError::Setup(format!(
+            "discretisation.lattice = \"fcc\": 3D runs are not available yet. The FCC lattice, its bodies (body.shape = \"{}\") and its micro-moduli are built, and `sppm check` reports them; groups, supports and the run on a 3D body come next (issue \"3D\")",
+            scene.body.name()
+        )));
+    }
     let need = estimated_memory(scene);
     if let Some(avail) = available_memory() {
         if need > 0.8 * avail as f64 {
@@ -283,16 +296,22 @@ fn assemble<const K: usize>(
     stage("micro-moduli and the surface correction");
     let mut particles = particles;
     // Bulk constants (4.5), (4.6) of each particle's own spacing; reported at the nominal one.
-    let bulk = micro_modulus::hexagonal(m.youngs_modulus(), m.nu, d.spacing, m.thickness, m.plane);
-    let dmat = micro_modulus::elasticity_matrix(m.youngs_modulus(), m.nu, m.plane);
+    let bulk = micro_modulus::hexagonal(
+        m.youngs_modulus(),
+        m.nu,
+        d.spacing,
+        m.thickness(),
+        m.plane(),
+    );
+    let dmat = micro_modulus::elasticity_matrix(m.youngs_modulus(), m.nu, m.plane());
     let own: Vec<MicroModuli> = (0..n)
         .map(|i| {
             micro_modulus::hexagonal(
                 m.youngs_modulus(),
                 m.nu,
                 particles.length[i],
-                m.thickness,
-                m.plane,
+                m.thickness(),
+                m.plane(),
             )
         })
         .collect();
@@ -307,14 +326,14 @@ fn assemble<const K: usize>(
         corrected: 0,
         kept_bulk: 0,
         max_residual: 0.0,
-        body_volume: shape.area() * m.thickness,
+        body_volume: shape.area() * m.thickness(),
         particle_volume: 0.0,
     };
     if !is_random {
         stage("boundary particles: clipped Voronoi cells and fitted moduli");
         surface_treatment(
             &mut particles,
-            m.thickness,
+            m.thickness(),
             &shape,
             method,
             &dmat,
@@ -328,15 +347,15 @@ fn assemble<const K: usize>(
         (Some((_, generation)), true) => {
             let md = generation.min_distance;
             let (e, nu) =
-                crate::model::sppm_calibration::fit_target(m.youngs_modulus(), m.nu, m.plane, md)
+                crate::model::sppm_calibration::fit_target(m.youngs_modulus(), m.nu, m.plane(), md)
                     .map_err(|allowed| {
-                    RunError::Scene(crate::scene::SceneError::Invalid {
-                        key: "material.nu".into(),
-                        value: m.nu.to_string(),
-                        allowed,
-                    })
-                })?;
-            micro_modulus::elasticity_matrix(e, nu, m.plane)
+                        RunError::Scene(crate::scene::SceneError::Invalid {
+                            key: "material.nu".into(),
+                            value: m.nu.to_string(),
+                            allowed,
+                        })
+                    })?;
+            micro_modulus::elasticity_matrix(e, nu, m.plane())
         }
         _ => dmat,
     };
@@ -548,7 +567,7 @@ fn modal_failure<const K: usize>(model: &Model<K>, e: modal::ModalError) -> RunE
     let m = &model.scene.material;
     RunError::Setup(format!(
         "{text}. T1 is the lowest mode of the lattice held by its supports (groups.*.fix, groups.*.load); it cannot be found when the supports leave a mechanism, or when material.nu = {} is so close to -1 or 0.5 that the stiffness is too ill-conditioned ({:?} plane).{hanging}",
-        m.nu, m.plane
+        m.nu, m.plane()
     ))
 }
 

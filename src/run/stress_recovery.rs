@@ -139,7 +139,7 @@ pub fn recovered_stress<const K: usize>(
     strain: &[Matrix2<f64>],
 ) -> Vec<Matrix2<f64>> {
     let m = &model.scene.material;
-    let d = elasticity_matrix(m.youngs_modulus(), m.nu, m.plane);
+    let d = elasticity_matrix(m.youngs_modulus(), m.nu, m.plane());
     let factor = properties::stiffness_factors(&model.fields, m.youngs_modulus());
     strain
         .iter()

@@ -164,6 +164,56 @@ pub enum BodySpec {
         notch_depth: f64,
         notch_width: f64,
     },
+    /// A box (3D): `size` = [x, y, z] from its lower corner `origin`.
+    Box {
+        size: [f64; 3],
+        #[serde(default)]
+        origin: [f64; 3],
+    },
+    /// A circular cylinder (3D) of `diameter` and `length` along `axis` (default z) from the
+    /// centre of its base `base`.
+    Cylinder {
+        diameter: f64,
+        length: f64,
+        #[serde(default = "z_axis")]
+        axis: [f64; 3],
+        #[serde(default)]
+        base: [f64; 3],
+    },
+    /// A 2D `section` (any 2D shape, with the scene's cutouts) extruded through
+    /// z ∈ [0, thickness] (3D): the dog-bone and the notched beam as prisms.
+    Prism {
+        section: std::boxed::Box<BodySpec>,
+        thickness: f64,
+    },
+}
+
+fn z_axis() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+impl BodySpec {
+    /// The shape's name as a scene writes it (`body.shape`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            BodySpec::Rectangle { .. } => "rectangle",
+            BodySpec::Polygon { .. } => "polygon",
+            BodySpec::Disc { .. } => "disc",
+            BodySpec::Dogbone { .. } => "dogbone",
+            BodySpec::NotchedBeam { .. } => "notched_beam",
+            BodySpec::Box { .. } => "box",
+            BodySpec::Cylinder { .. } => "cylinder",
+            BodySpec::Prism { .. } => "prism",
+        }
+    }
+
+    /// Whether the shape is a solid (box, cylinder, prism) rather than a 2D section.
+    pub fn is_solid(&self) -> bool {
+        matches!(
+            self,
+            BodySpec::Box { .. } | BodySpec::Cylinder { .. } | BodySpec::Prism { .. }
+        )
+    }
 }
 
 /// A region cut out of the body (`[[cutouts]] shape = "..."`). Lengths in metres. The body
@@ -241,12 +291,13 @@ pub struct DiscretisationSpec {
     /// `spacing` (default `discretise::random::DEFAULT_MIN_DISTANCE`).
     #[serde(default)]
     pub min_distance: Option<f64>,
-    /// Lattice rotation about the origin, degrees.
+    /// Lattice rotation about the origin, degrees: one angle in 2D; in 3D (FCC) one angle
+    /// about z or three, [α, β, γ] about z, y and x (R = Rz(α)·Ry(β)·Rx(γ)).
     #[serde(default)]
-    pub rotation_deg: f64,
-    /// Lattice offset (m), applied after rotation.
-    #[serde(default)]
-    pub offset: [f64; 2],
+    pub rotation_deg: Rotation,
+    /// Lattice offset (m), applied after rotation: [x, y] in 2D; [x, y] or [x, y, z] in 3D.
+    #[serde(default = "default_offset")]
+    pub offset: Vec<f64>,
     /// How a lattice treats its boundary particles ([`Surface`]; default
     /// [`Surface::VoronoiFit`]).
     #[serde(default)]
@@ -256,6 +307,48 @@ pub struct DiscretisationSpec {
     /// other.
     #[serde(default)]
     pub surface_correction: Option<bool>,
+}
+
+/// A lattice's rotation (`discretisation.rotation_deg`): one angle (2D, or about z in 3D) or
+/// three angles [α, β, γ] about z, y and x (3D).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Rotation {
+    Angle(f64),
+    Angles([f64; 3]),
+}
+
+impl Default for Rotation {
+    fn default() -> Self {
+        Rotation::Angle(0.0)
+    }
+}
+
+impl Rotation {
+    /// The angle in the plane (2D); `None` for three angles.
+    pub fn planar(self) -> Option<f64> {
+        match self {
+            Rotation::Angle(a) => Some(a),
+            Rotation::Angles(_) => None,
+        }
+    }
+
+    /// The angle in the plane of a 2D scene (validated to be one angle; NaN otherwise).
+    pub fn angle(self) -> f64 {
+        self.planar().unwrap_or(f64::NAN)
+    }
+
+    /// [α, β, γ] about z, y and x (one angle is α).
+    pub fn angles(self) -> [f64; 3] {
+        match self {
+            Rotation::Angle(a) => [a, 0.0, 0.0],
+            Rotation::Angles(v) => v,
+        }
+    }
+}
+
+fn default_offset() -> Vec<f64> {
+    vec![0.0, 0.0]
 }
 
 /// How a lattice's boundary particles are weighted (`discretisation.surface`; MODEL.md §1,
@@ -303,6 +396,29 @@ impl DiscretisationSpec {
     pub fn is_random(&self) -> bool {
         self.lattice == "random"
     }
+
+    /// The spatial dimension: 3 for the FCC lattice, 2 otherwise.
+    pub fn dim(&self) -> usize {
+        if self.lattice == "fcc" {
+            3
+        } else {
+            2
+        }
+    }
+
+    /// The offset in the plane (2D; validated to have two components).
+    pub fn offset2(&self) -> [f64; 2] {
+        [
+            self.offset.first().copied().unwrap_or(0.0),
+            self.offset.get(1).copied().unwrap_or(0.0),
+        ]
+    }
+
+    /// The offset in space (3D; a missing z is 0).
+    pub fn offset3(&self) -> [f64; 3] {
+        let [x, y] = self.offset2();
+        [x, y, self.offset.get(2).copied().unwrap_or(0.0)]
+    }
 }
 
 fn default_lattice() -> String {
@@ -332,13 +448,27 @@ pub struct MaterialSpec {
     pub nu: f64,
     /// Density ρ (kg/m³).
     pub rho: f64,
-    /// Thickness t (m) of the 2D specimen.
-    pub thickness: f64,
-    #[serde(default = "default_plane")]
-    pub plane: Plane,
+    /// Thickness t (m) of the 2D specimen (required in 2D; a 3D body has its own extent and
+    /// refuses it).
+    #[serde(default)]
+    pub thickness: Option<f64>,
+    /// Plane stress or plane strain (2D; default plane stress; refused in 3D).
+    #[serde(default)]
+    pub plane: Option<Plane>,
 }
 
 impl MaterialSpec {
+    /// The 2D thickness t (m; validated present in 2D, NaN in 3D).
+    pub fn thickness(&self) -> f64 {
+        self.thickness.unwrap_or(f64::NAN)
+    }
+
+    /// Plane stress or strain of a 2D scene (plane stress unless given; the 3D formulas
+    /// ignore it).
+    pub fn plane(&self) -> Plane {
+        self.plane.unwrap_or(Plane::Stress)
+    }
+
     /// Young's modulus (Pa) after [`Scene::resolve`].
     pub fn youngs_modulus(&self) -> f64 {
         self.e.unwrap_or(f64::NAN)
@@ -451,10 +581,6 @@ fn default_initiation() -> Initiation {
 }
 fn default_crack_opening() -> CrackOpening {
     CrackOpening::Total
-}
-
-fn default_plane() -> Plane {
-    Plane::Stress
 }
 
 /// A named set of particles, with its supports and displacement loading.

@@ -86,11 +86,11 @@ impl Scene {
         self.validate_cutouts()?;
         super::random_fields::check(self)?;
         let d = &self.discretisation;
-        if d.lattice != "hexagonal" && d.lattice != "random" {
+        if !["hexagonal", "random", "fcc"].contains(&d.lattice.as_str()) {
             return Err(invalid(
                 "discretisation.lattice",
                 format!("{:?}", d.lattice),
-                "\"hexagonal\" (2D SPLM) or \"random\" (SPPM: random Voronoi-weighted particles); \"fcc\" is not available yet",
+                "\"hexagonal\" (2D SPLM), \"random\" (2D SPPM: random Voronoi-weighted particles) or \"fcc\" (3D SPLM)",
             ));
         }
         if d.is_random() {
@@ -103,7 +103,7 @@ impl Scene {
                     ));
                 }
             }
-            if d.offset != [0.0, 0.0] {
+            if d.offset.iter().any(|&o| o != 0.0) {
                 return Err(invalid(
                     "discretisation.offset",
                     format!("{:?}", d.offset),
@@ -141,9 +141,30 @@ impl Scene {
             ));
         }
         positive("discretisation.spacing", d.spacing)?;
-        finite("discretisation.rotation_deg", d.rotation_deg)?;
-        finite("discretisation.offset[0]", d.offset[0])?;
-        finite("discretisation.offset[1]", d.offset[1])?;
+        for (k, a) in d.rotation_deg.angles().iter().enumerate() {
+            finite(&format!("discretisation.rotation_deg[{k}]"), *a)?;
+        }
+        let components = if d.dim() == 3 { "2 or 3" } else { "2" };
+        if d.offset.len() != 2 && !(d.dim() == 3 && d.offset.len() == 3) {
+            return Err(invalid(
+                "discretisation.offset",
+                format!("{:?}", d.offset),
+                format!(
+                    "{components} components (m), [x, y]{}",
+                    if d.dim() == 3 { " or [x, y, z]" } else { "" }
+                ),
+            ));
+        }
+        for (k, o) in d.offset.iter().enumerate() {
+            finite(&format!("discretisation.offset[{k}]"), *o)?;
+        }
+        if d.dim() == 2 && d.rotation_deg.planar().is_none() {
+            return Err(invalid(
+                "discretisation.rotation_deg",
+                format!("{:?}", d.rotation_deg.angles()),
+                "one angle (degrees) for a 2D lattice; three angles [α, β, γ] are for lattice = \"fcc\"",
+            ));
+        }
         let size = self.body_size();
         if d.spacing > 0.5 * size {
             return Err(invalid(
@@ -159,7 +180,18 @@ impl Scene {
         let m = &self.material;
         positive("material.E", m.youngs_modulus())?;
         positive("material.rho", m.rho)?;
-        positive("material.thickness", m.thickness)?;
+        if self.discretisation.dim() == 2 {
+            match m.thickness {
+                Some(t) => positive("material.thickness", t)?,
+                None => {
+                    return Err(invalid(
+                        "material.thickness",
+                        "absent",
+                        "the thickness t (m) of the 2D specimen, > 0",
+                    ))
+                }
+            }
+        }
         if !(m.nu.is_finite() && m.nu > -1.0 && m.nu < 0.5) {
             return Err(invalid("material.nu", m.nu, "must satisfy -1 < nu < 0.5"));
         }
@@ -385,21 +417,59 @@ impl Scene {
     }
 
     fn validate_body(&self) -> Result<(), SceneError> {
-        match &self.body {
+        let dim = self.discretisation.dim();
+        if dim == 3 && !self.body.is_solid() {
+            return Err(invalid(
+                "body.shape",
+                format!("\"{}\"", self.body.name()),
+                format!("a solid for discretisation.lattice = \"fcc\" (3D): \"box\", \"cylinder\", or \"prism\" (a 2D section extruded through a thickness: shape = \"prism\", thickness = …, section = {{ shape = \"{}\", … }})", self.body.name()),
+            ));
+        }
+        if dim == 2 && self.body.is_solid() {
+            return Err(invalid(
+                "body.shape",
+                format!("\"{}\"", self.body.name()),
+                "a 2D shape (rectangle, polygon, disc, dogbone, notched_beam) for a 2D lattice; the solids box, cylinder and prism need discretisation.lattice = \"fcc\"",
+            ));
+        }
+        if dim == 3 {
+            if let Some(t) = self.material.thickness {
+                return Err(invalid(
+                    "material.thickness",
+                    t,
+                    "absent in 3D: the body's own extent gives its thickness (a prism's `body.thickness`)",
+                ));
+            }
+            if let Some(p) = self.material.plane {
+                return Err(invalid(
+                    "material.plane",
+                    format!("{p:?}").to_lowercase(),
+                    "absent in 3D: plane stress and plane strain are 2D idealisations of a solid",
+                ));
+            }
+        }
+        validate_shape(&self.body, "body")
+    }
+}
+
+/// The values of one body shape, its keys under `key` (`body`, or `body.section` of a prism).
+fn validate_shape(body: &BodySpec, key: &str) -> Result<(), SceneError> {
+    {
+        match body {
             BodySpec::Rectangle {
                 width,
                 height,
                 origin,
             } => {
-                positive("body.width", *width)?;
-                positive("body.height", *height)?;
-                finite("body.origin[0]", origin[0])?;
-                finite("body.origin[1]", origin[1])?;
+                positive(&format!("{key}.width"), *width)?;
+                positive(&format!("{key}.height"), *height)?;
+                finite(&format!("{key}.origin[0]"), origin[0])?;
+                finite(&format!("{key}.origin[1]"), origin[1])?;
             }
             BodySpec::Polygon { vertices } => {
                 if vertices.len() < 3 {
                     return Err(invalid(
-                        "body.vertices",
+                        &format!("{key}.vertices"),
                         format!("{} vertices", vertices.len()),
                         "at least 3 vertices",
                     ));
@@ -411,52 +481,92 @@ impl Scene {
                 let pts: Vec<_> = vertices.iter().map(|v| Vector2::new(v[0], v[1])).collect();
                 if crate::geometry::polygon_area(&pts).abs() <= 0.0 {
                     return Err(invalid(
-                        "body.vertices",
+                        &format!("{key}.vertices"),
                         format!("{vertices:?}"),
                         "a polygon with non-zero area",
                     ));
                 }
                 if polygon_self_intersects(&pts) {
                     return Err(invalid(
-                        "body.vertices",
+                        &format!("{key}.vertices"),
                         format!("{vertices:?}"),
                         "a simple polygon: each vertex once, edges that neither cross, touch nor overlap (an outline traversed twice is refused)",
                     ));
                 }
             }
             BodySpec::Disc { diameter, centre } => {
-                positive("body.diameter", *diameter)?;
-                finite("body.centre[0]", centre[0])?;
-                finite("body.centre[1]", centre[1])?;
+                positive(&format!("{key}.diameter"), *diameter)?;
+                finite(&format!("{key}.centre[0]"), centre[0])?;
+                finite(&format!("{key}.centre[1]"), centre[1])?;
             }
-            BodySpec::Dogbone { size } => positive("body.size", *size)?,
+            BodySpec::Dogbone { size } => positive(&format!("{key}.size"), *size)?,
+            BodySpec::Box { size, origin } => {
+                for d in 0..3 {
+                    positive(&format!("{key}.size[{d}]"), size[d])?;
+                    finite(&format!("{key}.origin[{d}]"), origin[d])?;
+                }
+            }
+            BodySpec::Cylinder {
+                diameter,
+                length,
+                axis,
+                base,
+            } => {
+                positive(&format!("{key}.diameter"), *diameter)?;
+                positive(&format!("{key}.length"), *length)?;
+                for d in 0..3 {
+                    finite(&format!("{key}.axis[{d}]"), axis[d])?;
+                    finite(&format!("{key}.base[{d}]"), base[d])?;
+                }
+                let norm = axis.iter().map(|a| a * a).sum::<f64>().sqrt();
+                if !(norm > 0.0 && norm.is_finite()) {
+                    return Err(invalid(
+                        format!("{key}.axis"),
+                        format!("{axis:?}"),
+                        "a direction [x, y, z] of non-zero length (it is normalised)",
+                    ));
+                }
+            }
+            BodySpec::Prism { section, thickness } => {
+                positive(&format!("{key}.thickness"), *thickness)?;
+                if section.is_solid() {
+                    return Err(invalid(
+                        format!("{key}.section.shape"),
+                        format!("\"{}\"", section.name()),
+                        "a 2D shape: rectangle, polygon, disc, dogbone or notched_beam",
+                    ));
+                }
+                validate_shape(section, &format!("{key}.section"))?;
+            }
             BodySpec::NotchedBeam {
                 length,
                 depth,
                 notch_depth,
                 notch_width,
             } => {
-                positive("body.length", *length)?;
-                positive("body.depth", *depth)?;
+                positive(&format!("{key}.length"), *length)?;
+                positive(&format!("{key}.depth"), *depth)?;
                 if !(notch_depth.is_finite() && *notch_depth >= 0.0 && notch_depth < depth) {
                     return Err(invalid(
-                        "body.notch_depth",
+                        &format!("{key}.notch_depth"),
                         notch_depth,
                         format!("0 <= notch_depth < depth ({depth})"),
                     ));
                 }
                 if !(notch_width.is_finite() && *notch_width >= 0.0 && notch_width < length) {
                     return Err(invalid(
-                        "body.notch_width",
+                        &format!("{key}.notch_width"),
                         notch_width,
                         format!("0 <= notch_width < length ({length})"),
                     ));
                 }
             }
         }
-        Ok(())
     }
+    Ok(())
+}
 
+impl Scene {
     /// The values of `[[cutouts]]`, then their geometry: each must meet the body, one that
     /// crosses the outline must have an exact area (every cutout but a disc across a disc's
     /// or a dog-bone's arc), none may overlap another (crack lines aside), and together they
@@ -465,6 +575,13 @@ impl Scene {
         use crate::geometry::{cutout_area_in, Cutout, Shape2};
         if self.cutouts.is_empty() {
             return Ok(());
+        }
+        if matches!(self.body, BodySpec::Box { .. } | BodySpec::Cylinder { .. }) {
+            return Err(invalid(
+                "cutouts",
+                format!("{} cutouts on body.shape = \"{}\"", self.cutouts.len(), self.body.name()),
+                "cutouts on a 2D body or on a prism's section (shape = \"prism\"), through its whole thickness",
+            ));
         }
         let outer = self.outer_shape();
         let size = outer.size();
@@ -649,20 +766,12 @@ impl Scene {
 
     /// The body's smallest overall dimension (m).
     pub fn body_size(&self) -> f64 {
-        match &self.body {
-            BodySpec::Rectangle { width, height, .. } => width.min(*height),
-            BodySpec::Polygon { .. } => {
-                let (lo, hi) = self.shape().bounding_box();
-                (hi - lo).min()
-            }
-            BodySpec::Disc { diameter, .. } => *diameter,
-            BodySpec::Dogbone { size } => 0.6 * size,
-            BodySpec::NotchedBeam { length, depth, .. } => length.min(*depth),
-        }
+        shape_size(&self.body, &self.shape())
     }
 
     /// The geometric shape of the body: the outer shape ([`Self::outer_shape`]) and, when the
-    /// scene has cutouts, less them (`Shape2::WithCutouts`).
+    /// scene has cutouts, less them (`Shape2::WithCutouts`). For a solid: a prism's section;
+    /// the xy-extent of a box or a cylinder (3D code asks for [`Self::solid`]).
     pub fn shape(&self) -> crate::geometry::Shape2 {
         let outer = self.outer_shape();
         if self.cutouts.is_empty() {
@@ -674,39 +783,126 @@ impl Scene {
         }
     }
 
-    /// The shape of `[body]`, without the cutouts.
+    /// The shape of `[body]`, without the cutouts (see [`Self::shape`] for solids).
     pub fn outer_shape(&self) -> crate::geometry::Shape2 {
-        use crate::geometry::Shape2;
+        section_shape(&self.body)
+    }
+
+    /// The solid of a 3D scene: a box, a cylinder (its axis normalised), or the prism of
+    /// [`Self::shape`] (the section with the cutouts); `None` for a 2D body.
+    pub fn solid(&self) -> Option<crate::geometry::Shape3> {
+        use crate::geometry::Shape3;
+        use nalgebra::Vector3;
         match &self.body {
-            BodySpec::Rectangle {
-                width,
-                height,
-                origin,
-            } => Shape2::Rectangle {
-                origin: Vector2::new(origin[0], origin[1]),
-                width: *width,
-                height: *height,
-            },
-            BodySpec::Polygon { vertices } => Shape2::Polygon {
-                vertices: vertices.iter().map(|v| Vector2::new(v[0], v[1])).collect(),
-            },
-            BodySpec::Disc { diameter, centre } => Shape2::Disc {
-                centre: Vector2::new(centre[0], centre[1]),
-                radius: 0.5 * diameter,
-            },
-            BodySpec::Dogbone { size } => Shape2::DogBone { size: *size },
-            BodySpec::NotchedBeam {
+            BodySpec::Box { size, origin } => Some(Shape3::Box {
+                origin: Vector3::from(*origin),
+                size: Vector3::from(*size),
+            }),
+            BodySpec::Cylinder {
+                diameter,
                 length,
-                depth,
-                notch_depth,
-                notch_width,
-            } => Shape2::NotchedBeam {
+                axis,
+                base,
+            } => Some(Shape3::Cylinder {
+                base: Vector3::from(*base),
+                axis: Vector3::from(*axis).normalize(),
+                radius: 0.5 * diameter,
                 length: *length,
-                depth: *depth,
-                notch_depth: *notch_depth,
-                notch_width: *notch_width,
-            },
+            }),
+            BodySpec::Prism { thickness, .. } => Some(Shape3::Extruded {
+                section: self.shape(),
+                thickness: *thickness,
+            }),
+            _ => None,
         }
+    }
+}
+
+/// The smallest overall dimension (m) of a body shape (`shape`: its 2D shape).
+fn shape_size(body: &BodySpec, shape: &crate::geometry::Shape2) -> f64 {
+    match body {
+        BodySpec::Rectangle { width, height, .. } => width.min(*height),
+        BodySpec::Polygon { .. } => {
+            let (lo, hi) = shape.bounding_box();
+            (hi - lo).min()
+        }
+        BodySpec::Disc { diameter, .. } => *diameter,
+        BodySpec::Dogbone { size } => 0.6 * size,
+        BodySpec::NotchedBeam { length, depth, .. } => length.min(*depth),
+        BodySpec::Box { size, .. } => size[0].min(size[1]).min(size[2]),
+        BodySpec::Cylinder {
+            diameter, length, ..
+        } => diameter.min(*length),
+        BodySpec::Prism { section, thickness } => shape_size(section, shape).min(*thickness),
+    }
+}
+
+/// The 2D shape of a body shape: itself, a prism's section, the xy-extent of a box, the
+/// disc of a cylinder along z (the xy-bounding rectangle of one along another axis).
+fn section_shape(body: &BodySpec) -> crate::geometry::Shape2 {
+    use crate::geometry::Shape2;
+    match body {
+        BodySpec::Rectangle {
+            width,
+            height,
+            origin,
+        } => Shape2::Rectangle {
+            origin: Vector2::new(origin[0], origin[1]),
+            width: *width,
+            height: *height,
+        },
+        BodySpec::Polygon { vertices } => Shape2::Polygon {
+            vertices: vertices.iter().map(|v| Vector2::new(v[0], v[1])).collect(),
+        },
+        BodySpec::Disc { diameter, centre } => Shape2::Disc {
+            centre: Vector2::new(centre[0], centre[1]),
+            radius: 0.5 * diameter,
+        },
+        BodySpec::Dogbone { size } => Shape2::DogBone { size: *size },
+        BodySpec::NotchedBeam {
+            length,
+            depth,
+            notch_depth,
+            notch_width,
+        } => Shape2::NotchedBeam {
+            length: *length,
+            depth: *depth,
+            notch_depth: *notch_depth,
+            notch_width: *notch_width,
+        },
+        BodySpec::Box { size, origin } => Shape2::Rectangle {
+            origin: Vector2::new(origin[0], origin[1]),
+            width: size[0],
+            height: size[1],
+        },
+        BodySpec::Cylinder {
+            diameter,
+            length,
+            axis,
+            base,
+        } => {
+            let a = nalgebra::Vector3::from(*axis).normalize();
+            let r = 0.5 * diameter;
+            if a.x.abs() < 1e-12 && a.y.abs() < 1e-12 {
+                return Shape2::Disc {
+                    centre: Vector2::new(base[0], base[1]),
+                    radius: r,
+                };
+            }
+            let solid = crate::geometry::Shape3::Cylinder {
+                base: nalgebra::Vector3::from(*base),
+                axis: a,
+                radius: r,
+                length: *length,
+            };
+            let (lo, hi) = solid.bounding_box();
+            Shape2::Rectangle {
+                origin: Vector2::new(lo.x, lo.y),
+                width: hi.x - lo.x,
+                height: hi.y - lo.y,
+            }
+        }
+        BodySpec::Prism { section, .. } => section_shape(section),
     }
 }
 

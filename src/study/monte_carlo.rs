@@ -293,7 +293,7 @@ pub struct MonteCarloArgs {
 /// dog-bone (σN is then the mean stress over the neck), else b = 1 and D the body's width.
 pub fn nominal_strength(scene: &Scene, peak_force_n: f64) -> f64 {
     let (d, b) = nominal_size(scene);
-    peak_force_n.abs() / (b * d * scene.material.thickness)
+    peak_force_n.abs() / (b * d * scene.material.thickness())
 }
 
 /// (D, b) of [`nominal_strength`].
@@ -308,13 +308,7 @@ fn nominal_size(scene: &Scene) -> (f64, f64) {
 }
 
 fn body_name(body: &BodySpec) -> &'static str {
-    match body {
-        BodySpec::Rectangle { .. } => "rectangle",
-        BodySpec::Polygon { .. } => "polygon",
-        BodySpec::Disc { .. } => "disc",
-        BodySpec::Dogbone { .. } => "dogbone",
-        BodySpec::NotchedBeam { .. } => "notched_beam",
-    }
+    body.name()
 }
 
 /// The label of a size: D in mm, e.g. `D50mm`.

@@ -292,7 +292,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     let per_angle_runs = args.offsets as u128 + 1;
     let count = args.angles_deg.len() as u128 * per_angle_runs;
     let spacing = d.spacing;
-    let scene_offset = d.offset;
+    let scene_offset = d.offset2();
     // random particles: "offset" k is realisation k, a particle set of its own seed (k = 0:
     // the scene's seed), turned by the angle
     let random = d.is_random();
