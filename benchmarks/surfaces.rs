@@ -66,7 +66,7 @@ fn main() {
                             cantilever_stiffness(h * L0, 10.0 * h * L0, &p).expect("cantilever");
                         let mass: f64 = model.mech.mass.iter().sum();
                         let want =
-                            2400.0 * model.scene.shape().area() * model.scene.material.thickness;
+                            2400.0 * model.scene.shape().area() * model.scene.material.thickness();
                         format!(
                             "{:+.2} (m {:+.2})",
                             (k - 1.0) * 100.0,

@@ -469,7 +469,7 @@ fn validate_shape(body: &BodySpec, key: &str) -> Result<(), SceneError> {
             BodySpec::Polygon { vertices } => {
                 if vertices.len() < 3 {
                     return Err(invalid(
-                        &format!("{key}.vertices"),
+                        format!("{key}.vertices"),
                         format!("{} vertices", vertices.len()),
                         "at least 3 vertices",
                     ));
@@ -481,14 +481,14 @@ fn validate_shape(body: &BodySpec, key: &str) -> Result<(), SceneError> {
                 let pts: Vec<_> = vertices.iter().map(|v| Vector2::new(v[0], v[1])).collect();
                 if crate::geometry::polygon_area(&pts).abs() <= 0.0 {
                     return Err(invalid(
-                        &format!("{key}.vertices"),
+                        format!("{key}.vertices"),
                         format!("{vertices:?}"),
                         "a polygon with non-zero area",
                     ));
                 }
                 if polygon_self_intersects(&pts) {
                     return Err(invalid(
-                        &format!("{key}.vertices"),
+                        format!("{key}.vertices"),
                         format!("{vertices:?}"),
                         "a simple polygon: each vertex once, edges that neither cross, touch nor overlap (an outline traversed twice is refused)",
                     ));
@@ -548,14 +548,14 @@ fn validate_shape(body: &BodySpec, key: &str) -> Result<(), SceneError> {
                 positive(&format!("{key}.depth"), *depth)?;
                 if !(notch_depth.is_finite() && *notch_depth >= 0.0 && notch_depth < depth) {
                     return Err(invalid(
-                        &format!("{key}.notch_depth"),
+                        format!("{key}.notch_depth"),
                         notch_depth,
                         format!("0 <= notch_depth < depth ({depth})"),
                     ));
                 }
                 if !(notch_width.is_finite() && *notch_width >= 0.0 && notch_width < length) {
                     return Err(invalid(
-                        &format!("{key}.notch_width"),
+                        format!("{key}.notch_width"),
                         notch_width,
                         format!("0 <= notch_width < length ({length})"),
                     ));
