@@ -43,9 +43,11 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
-    /// Throughput of the step kernel on a square hexagonal-lattice block (one JSON line).
+    /// Throughput of the step kernel on a square hexagonal-lattice block or (--dim 3) an FCC
+    /// cube (one JSON line).
     Bench {
-        /// Dimension (2; 3D arrives with the FCC lattice).
+        /// Dimension: 2 (square block of hexagonal lattice) or 3 (cube of FCC lattice,
+        /// 18 neighbours; elastic kernel only).
         #[arg(long, default_value_t = 2)]
         dim: usize,
         #[arg(long, default_value_t = 100_000)]
@@ -196,8 +198,8 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             lattice,
         } => {
             anyhow::ensure!(
-                dim == 2,
-                "--dim {dim}: only 2 is available (3D arrives with the FCC lattice)"
+                dim == 2 || dim == 3,
+                "--dim {dim}: 2 (hexagonal lattice) or 3 (FCC lattice, --model elastic)"
             );
             let kernel = match model.as_str() {
                 "elastic" => sppm::solver::KernelSet::Elastic,
@@ -217,11 +219,26 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 layout.name(),
                 kernel.name()
             );
+            if dim == 3 {
+                anyhow::ensure!(
+                    kernel == sppm::solver::KernelSet::Elastic,
+                    "--model {model} with --dim 3: the concrete kernels are 2D only; --dim 3 runs --model elastic"
+                );
+                anyhow::ensure!(
+                    layout == sppm::bench::Layout::Slots,
+                    "--layout {} with --dim 3: the FCC lattice runs on \"slots\"",
+                    layout.name()
+                );
+                anyhow::ensure!(
+                    lattice == "hexagonal" || lattice == "fcc",
+                    "--lattice {lattice} with --dim 3: the 3D benchmark runs the FCC lattice (\"fcc\")"
+                );
+            }
             anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
             sppm::limits::check_count(
                 "--particles",
                 particles as f64,
-                sppm::bench::bytes_per_particle(kernel) as f64,
+                sppm::bench::bytes_per_particle(kernel, dim) as f64,
                 "particles",
             )?;
             anyhow::ensure!(threads >= 1, "--threads {threads}: at least 1");
@@ -229,8 +246,12 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 threads <= 4096,
                 "--threads {threads}: at most 4096 worker threads"
             );
-            let r = sppm::bench::bench(particles, steps.max(1), threads, kernel, layout, &lattice)
-                .context("benchmark failed")?;
+            let r = if dim == 3 {
+                sppm::bench::bench_fcc(particles, steps.max(1), threads)
+            } else {
+                sppm::bench::bench(particles, steps.max(1), threads, kernel, layout, &lattice)
+            }
+            .context("benchmark failed")?;
             say!("{}", serde_json::to_string(&r)?);
             Ok(ExitCode::SUCCESS)
         }

@@ -169,13 +169,18 @@ impl<const D: usize, const K: usize> Particles<D, K> {
 /// Bytes of memory per particle that a run of dimension D with K slots allocates
 /// (discretisation, model and solver state), used to refuse scenes too large for the machine
 /// before anything is allocated.
+///
+/// Counted field by field (`Particles`, `solver::mechanics::Mechanics`,
+/// `solver::kernel::State`): x0, x, x_next, v, v_next, force, force_prev: 7·D f64; volume,
+/// horizon, length and the body's a, b, c; the kernel's a, b, mass, inv_mass, c_in, c_ex;
+/// b·θ and the damper work: 14 f64, and in 3D the kernel's second-neighbour c (MODEL.md §3):
+/// 15; per slot the neighbour index twice (the body's and the kernel's, u32), reverse (u8),
+/// l0 and 1/l0 (f64) and the bond cache's stretch and inverse length (f64): 41 bytes; the
+/// kernel's slot end (u8), group bookkeeping and outputs: ~64 bytes. D = 2, K = 6: 534 B;
+/// D = 3, K = 18 (FCC): 1090 B.
 pub const fn bytes_per_particle(d: usize, k: usize) -> usize {
-    // x0, x, x_next, v, v_next, force, force_prev: 7·D f64; volume, horizon, length, the
-    // body's a, b, c, mass, inv_mass, the kernel's a, b, c_in, c_ex, b·theta, damping
-    // energy: 14 f64; neighbours (u32), reverse (u8),
-    // l0 and 1/l0 (f64) and the kernel's cached stretch and 1/length (f64) per slot; group
-    // bookkeeping and outputs: ~64 bytes.
-    7 * d * 8 + 14 * 8 + k * (4 + 1 + 32) + 64
+    let scalars = if d == 3 { 15 } else { 14 };
+    7 * d * 8 + scalars * 8 + k * (2 * 4 + 1 + 4 * 8) + 64
 }
 
 /// Slots per particle of the standard lattices: 6 for the 2D hexagonal lattice, 18 for 3D.
@@ -184,5 +189,14 @@ pub const fn slots(d: usize) -> usize {
         6
     } else {
         18
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn bytes_per_particle_of_the_lattices() {
+        assert_eq!(super::bytes_per_particle(2, 6), 534);
+        assert_eq!(super::bytes_per_particle(3, 18), 1090);
     }
 }

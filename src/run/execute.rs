@@ -14,17 +14,18 @@ use crate::scene::{Scene, SolverMethod};
 use crate::solver::concrete::Concrete;
 use crate::solver::mechanics::{weighted, Mechanics};
 use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
-use nalgebra::{Matrix2, Vector2};
+use nalgebra::{SMatrix, SVector, Vector2};
 use std::time::Instant;
 
-/// Particle stresses (3.18) at positions x: σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(e_ij ⊗ e_ij)
-/// with F_s,ij = a_i·S_ij + b_i·θ_i (θ_i = Σ_m w_im·S_im, `Mechanics::weights`) and e_ij the
-/// current bond direction.
-pub fn particle_stress<const K: usize>(
-    mech: &Mechanics<2, K>,
+/// Particle stresses (3.18) at positions x, in D dimensions: σ_i = (1/(2ΔV_i))·Σ_j
+/// L0,ij·F_s,ij·(e_ij ⊗ e_ij) with F_s,ij = a_i·S_ij + b_i·θ_i (a_i + c_i in an FCC
+/// second-neighbour slot, MODEL.md §3 erratum; θ_i = Σ_m w_im·S_im, `Mechanics::weights`)
+/// and e_ij the current bond direction.
+pub fn particle_stress<const D: usize, const K: usize>(
+    mech: &Mechanics<D, K>,
     volume: &[f64],
-    x: &[Vector2<f64>],
-) -> Vec<Matrix2<f64>> {
+    x: &[SVector<f64, D>],
+) -> Vec<SMatrix<f64, D, D>> {
     (0..x.len())
         .map(|i| {
             let mut theta = 0.0;
@@ -32,15 +33,19 @@ pub fn particle_stress<const K: usize>(
             for (k, j, il) in mech.bonds(i) {
                 theta += weighted(w, k, total_stretch((x[j] - x[i]).norm(), il));
             }
-            let mut acc = StressSum::default();
-            for (_, j, il) in mech.bonds(i) {
+            let mut acc = StressSum::<D>::default();
+            for (k, j, il) in mech.bonds(i) {
                 let d = x[j] - x[i];
                 let len = d.norm();
                 let s = total_stretch(len, il);
                 acc.add(
                     &(d / len),
                     1.0 / il,
-                    force_state(mech.a[i], s, dilatation_term(mech.b[i], theta)),
+                    force_state(
+                        mech.slot_modulus(i, k),
+                        s,
+                        dilatation_term(mech.b[i], theta),
+                    ),
                 );
             }
             acc.finish(volume[i])

@@ -693,6 +693,7 @@ pub fn step<
     Dim<D>: Dimension<D>,
 {
     debug_assert!(FULL || c.kernel() == KernelSet::Tension);
+    m.assert_no_second("the concrete kernel (2D only for now)");
     pass_state::<D, K, L, FULL>(m, c, &st.x, &mut st.b_theta);
     #[cfg(target_arch = "x86_64")]
     let avx = c.simd && use_avx() && super::kernel::avx::vector_update::<D>();
@@ -733,6 +734,7 @@ pub fn internal_forces<const D: usize, const K: usize, L: DamageLaw<D, K>>(
 where
     Dim<D>: Dimension<D>,
 {
+    m.assert_no_second("the concrete kernel (2D only for now)");
     let mut bt = vec![0.0; x.len()];
     match c.kernel() {
         KernelSet::Tension => pass_state::<D, K, L, false>(m, c, x, &mut bt),
@@ -760,6 +762,7 @@ pub fn internal_energy<const D: usize, const K: usize, L: DamageLaw<D, K>>(
 where
     Dim<D>: Dimension<D>,
 {
+    m.assert_no_second("the concrete energy (2D only for now)");
     let per_particle: Vec<f64> = (0..x.len())
         .into_par_iter()
         .with_min_len(256)
@@ -789,6 +792,7 @@ pub fn particle_stress<const D: usize, const K: usize, L: DamageLaw<D, K>>(
 where
     Dim<D>: Dimension<D>,
 {
+    m.assert_no_second("the concrete stress (2D only for now)");
     (0..x.len())
         .map(|i| {
             let (sl, bt) = slots::<D, K, L, true>(m, c, x, i);

@@ -75,6 +75,8 @@ fn check_sizes<const D: usize, const K: usize>(csr: &Csr, m: &Mechanics<D, K>, n
         m.len()
     );
     assert!(m.c_in.len() == n && m.c_ex.len() == n && m.inv_mass.len() == n);
+    // CSR bonds have no slots, so no second-neighbour slots (MODEL.md §3, FCC)
+    m.assert_no_second("the CSR kernel");
 }
 
 /// b_i·Σ_m S_im of particle i; with `CACHE`, each bond's stretch and inverse length go to
@@ -707,6 +709,7 @@ mod tests {
             slot_inv_l0: None,
             a,
             b,
+            second: None,
             inv_mass: mass.iter().map(|m| 1.0 / m).collect_aligned(),
             mass,
             c_in,

@@ -7,7 +7,11 @@
 //! 2. for each particle, over its own slots: the bond force
 //!    F_b,ij = ½(F_s,ij + F_s,ji) = ½((a_i + a_j)·S_ij + bθ_i + bθ_j) (3.7, 3.8) along the
 //!    current unit vector e_ij, plus the bond damper (3.55), then central differences
-//!    (3.58) with the particle damper (3.56) taken semi-implicitly.
+//!    (3.58) with the particle damper (3.56) taken semi-implicitly. In an FCC
+//!    second-neighbour slot (`Mechanics::second`, MODEL.md §3 with its erratum) the bond
+//!    moduli are a + c: F_b,ij = ½((a_i + c_i) + (a_j + c_j))·S_ij + ½(bθ_i + bθ_j). The
+//!    test of whether a model has c is made once per particle (scalar) or per block of four
+//!    (AVX), outside the slot loop; without c the code is the one without it.
 //!
 //! Both passes have an explicit AVX path (`mod avx`, chosen at run time, no FMA) that treats
 //! four consecutive particles at once, one per lane, slot by slot; an empty slot is masked to
@@ -264,6 +268,8 @@ fn pass_dilatation_cached<const D: usize, const K: usize>(
 
 /// Internal force on particle i at positions x with velocities v (bond dampers if `DAMP`);
 /// returns the force and the power dissipated in its bond dampers (half of each bond's).
+/// Second-neighbour slots use the moduli a + c where the model has them
+/// ([`Mechanics::bond_moduli`]).
 #[inline(always)]
 pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
     m: &Mechanics<D, K>,
@@ -272,9 +278,30 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
     b_theta: &[f64],
     i: usize,
 ) -> (SVector<f64, D>, f64) {
+    match &m.second {
+        None => particle_force_impl::<D, K, DAMP, false>(m, &[], 0, x, v, b_theta, i),
+        Some(s) => particle_force_impl::<D, K, DAMP, true>(m, &s.c, s.first_slot, x, v, b_theta, i),
+    }
+}
+
+/// [`particle_force`]; with `SECOND`, slots `first..K` are second neighbours with the moduli
+/// a + c (`c` per particle), otherwise `c` and `first` are unused.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn particle_force_impl<const D: usize, const K: usize, const DAMP: bool, const SECOND: bool>(
+    m: &Mechanics<D, K>,
+    c: &[f64],
+    first: usize,
+    x: &[SVector<f64, D>],
+    v: &[SVector<f64, D>],
+    b_theta: &[f64],
+    i: usize,
+) -> (SVector<f64, D>, f64) {
     debug_assert!(x.len() == m.len() && v.len() == m.len() && b_theta.len() == m.len());
+    debug_assert!(!SECOND || c.len() == m.len());
     let xi = x[i];
     let ai = m.a[i];
+    let aci = if SECOND { ai + c[i] } else { ai };
     let bti = b_theta[i];
     let nb = &m.neighbours[i];
     let il = &m.inv_l0[i];
@@ -287,7 +314,7 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
         }
         let j = j as usize;
         // SAFETY: Mechanics::new checks every occupied slot indexes a particle, and the
-        // state arrays have one entry per particle.
+        // state arrays have one entry per particle (c too, asserted in debug builds).
         let (xj, aj, btj) = unsafe {
             (
                 *x.get_unchecked(j),
@@ -299,7 +326,12 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
         let len = d.norm();
         let e = d * (1.0 / len);
         let s = total_stretch(len, il[k]);
-        let mut fb = bond_force(ai, aj, s, bti, btj);
+        let mut fb = if SECOND && k >= first {
+            let acj = aj + unsafe { *c.get_unchecked(j) };
+            bond_force(aci, acj, s, bti, btj)
+        } else {
+            bond_force(ai, aj, s, bti, btj)
+        };
         if DAMP {
             let (vj, cj) = unsafe { (*v.get_unchecked(j), *m.c_in.get_unchecked(j)) };
             let c = 0.5 * (m.c_in[i] + cj);
@@ -771,12 +803,14 @@ pub(crate) mod avx {
 
     /// `super::particle_force` of particles i0..i0+4, one per lane, as SoA: the force per
     /// component and the bond-damper power. With `CACHE`, each slot's stretch and inverse
-    /// length come from `cache` (the whole bond cache) instead of being recomputed.
+    /// length come from `cache` (the whole bond cache) instead of being recomputed. With
+    /// `SECOND`, the model has second-neighbour moduli (`m.second`) and their slots take
+    /// the moduli a + c, added in the scalar code's order.
     ///
     /// # Safety
     /// AVX available; i0 + 4 ≤ m.len(); x, v and b_theta have m.len() entries; every
     /// occupied slot indexes a particle; with `CACHE`, cache holds block i0/4 and pass 1
-    /// filled it at positions x.
+    /// filled it at positions x; with `SECOND`, `m.second` is `Some` with m.len() entries.
     #[target_feature(enable = "avx")]
     #[inline]
     pub unsafe fn force_block<
@@ -784,6 +818,7 @@ pub(crate) mod avx {
         const K: usize,
         const DAMP: bool,
         const CACHE: bool,
+        const SECOND: bool,
     >(
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
@@ -801,6 +836,16 @@ pub(crate) mod avx {
             [_mm256_setzero_pd(); D]
         };
         let ai = _mm256_loadu_pd(m.a.as_ptr().add(i0));
+        // second-neighbour moduli: c per particle, a_i + c_i, the first slot (unused
+        // without SECOND)
+        let (sc, aci, first): (&[f64], __m256d, usize) = match (SECOND, &m.second) {
+            (true, Some(s)) => (
+                &s.c[..],
+                _mm256_add_pd(ai, _mm256_loadu_pd(s.c.as_ptr().add(i0))),
+                s.first_slot,
+            ),
+            _ => (&[], ai, usize::MAX),
+        };
         let bti = _mm256_loadu_pd(b_theta.as_ptr().add(i0));
         let ci = if DAMP {
             _mm256_loadu_pd(m.c_in.as_ptr().add(i0))
@@ -827,11 +872,17 @@ pub(crate) mod avx {
             };
             let aj = gather(&m.a, &j);
             let btj = gather(b_theta, &j);
-            // 0.5 * ((ai + aj) * s + bti + btj)
+            // the bond moduli: (a_i + c_i, a_j + c_j) in a second-neighbour slot
+            let (mi, mj) = if SECOND && k >= first {
+                (aci, _mm256_add_pd(aj, gather(sc, &j)))
+            } else {
+                (ai, aj)
+            };
+            // 0.5 * ((mi + mj) * s + bti + btj)
             let mut fb = _mm256_mul_pd(
                 half,
                 _mm256_add_pd(
-                    _mm256_add_pd(_mm256_mul_pd(_mm256_add_pd(ai, aj), st), bti),
+                    _mm256_add_pd(_mm256_mul_pd(_mm256_add_pd(mi, mj), st), bti),
                     btj,
                 ),
             );
@@ -1022,9 +1073,14 @@ pub(crate) mod avx {
         } = inp;
         let ChunkOut { xn, vn, fo, dw } = out;
         let vector_update = vector_update::<D>();
+        let second = m.second.is_some();
         for o0 in (0..xn.len()).step_by(4) {
             let i0 = base + o0;
-            let (f, power) = force_block::<D, K, DAMP, CACHE>(m, x, v, b_theta, cache, i0);
+            let (f, power) = if second {
+                force_block::<D, K, DAMP, CACHE, true>(m, x, v, b_theta, cache, i0)
+            } else {
+                force_block::<D, K, DAMP, CACHE, false>(m, x, v, b_theta, cache, i0)
+            };
             if vector_update {
                 update_block::<D, K, LAG, DAMP>(
                     m, x, v, force_prev, dt, i0, o0, &f, power, xn, vn, fo, dw,
@@ -1098,6 +1154,7 @@ mod tests {
             inv_l0: copied(&inv_l0),
             a,
             b,
+            second: None,
             inv_mass: mass.iter().map(|m| 1.0 / m).collect_aligned(),
             mass,
             c_in,
@@ -1116,10 +1173,27 @@ mod tests {
 
     /// The kernel against the plain per-particle code, bit for bit, on 1 and 2 threads, with
     /// a reference length per bond and with one per slot (a lattice: the AVX blocks
-    /// broadcast [`Mechanics::slot_inv_l0`]).
+    /// broadcast [`Mechanics::slot_inv_l0`]); with 18 slots also with FCC second-neighbour
+    /// moduli c in slots 12..18.
     fn check<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>() {
         check_weighted::<D, K, LAG, DAMP>(false, false);
         check_weighted::<D, K, LAG, DAMP>(false, true);
+        if K == 18 {
+            let n = 2 * CHUNK + 4 * 37 + 3;
+            let (mut m, st0) = model::<D, K>(n);
+            with_second(&mut m);
+            check_model::<D, K, LAG, DAMP>(&m, &st0);
+        }
+    }
+
+    /// Random second-neighbour moduli c (about −0.65·a, as FCC's) in slots 12..K.
+    fn with_second<const D: usize, const K: usize>(m: &mut Mechanics<D, K>) {
+        let mut r = Lcg(99);
+        let c =
+            m.a.iter()
+                .map(|a| -0.65 * a * (1.0 + 0.1 * r.next()))
+                .collect_aligned();
+        m.second = Some(crate::solver::mechanics::SecondNeighbours { c, first_slot: 12 });
     }
 
     /// [`check`]; with `weighted`, the body weighs its dilatations (random particles); with
@@ -1161,17 +1235,26 @@ mod tests {
                     .collect_aligned(),
             );
         }
+        check_model::<D, K, LAG, DAMP>(&m, &st0);
+    }
+
+    /// The kernel's step of model `m` from state `st0` against the plain per-particle code.
+    fn check_model<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
+        m: &Mechanics<D, K>,
+        st0: &State<D>,
+    ) {
+        let n = m.len();
         let dt = 1e-7;
         let mut want = st0.clone();
         for i in 0..n {
-            want.b_theta[i] = dilatation_one(&m, &st0.x, i);
+            want.b_theta[i] = dilatation_one(m, &st0.x, i);
         }
         for i in 0..n {
-            let (f, p) = particle_force::<D, K, DAMP>(&m, &st0.x, &st0.v, &want.b_theta, i);
+            let (f, p) = particle_force::<D, K, DAMP>(m, &st0.x, &st0.v, &want.b_theta, i);
             want.force[i] = f;
             let (mut xn, mut vn, mut dw) = (st0.x_next[i], st0.v_next[i], st0.damping_work[i]);
             let inp = Inputs {
-                m: &m,
+                m,
                 x: &st0.x,
                 v: &st0.v,
                 b_theta: &want.b_theta,
@@ -1188,7 +1271,7 @@ mod tests {
                 .build()
                 .unwrap();
             let mut st = st0.clone();
-            pool.install(|| step::<D, K, LAG, DAMP>(&m, &mut st, dt));
+            pool.install(|| step::<D, K, LAG, DAMP>(m, &mut st, dt));
             let bits = |v: &[SVector<f64, D>]| {
                 v.iter()
                     .flat_map(|p| p.iter().map(|c| c.to_bits()).collect::<Vec<_>>())
@@ -1203,8 +1286,8 @@ mod tests {
             // the public passes, without the bond cache
             let mut st = st0.clone();
             pool.install(|| {
-                pass_dilatation(&m, &st.x, &mut st.b_theta);
-                pass_update::<D, K, LAG, DAMP>(&m, &mut st, dt)
+                pass_dilatation(m, &st.x, &mut st.b_theta);
+                pass_update::<D, K, LAG, DAMP>(m, &mut st, dt)
             });
             assert_eq!(sbits(&st.b_theta), sbits(&want.b_theta));
             assert_eq!(bits(&st.force), bits(&want.force));
@@ -1212,6 +1295,53 @@ mod tests {
             assert_eq!(bits(&st.v_next), bits(&want.v_next));
             assert_eq!(sbits(&st.damping_work), sbits(&want.damping_work));
         }
+    }
+
+    /// (a) of issue 15's kernel: on a randomly perturbed FCC block (`bench::fcc_block`: 18
+    /// slots, second neighbours in 12..18) with per-particle a, b and c ≠ 0, moving, the AVX
+    /// blocks and the scalar code agree bit for bit, and c changes the forces.
+    #[test]
+    fn fcc_block_with_second_neighbours_matches_scalar_reference_bitwise() {
+        let l0 = 1e-3;
+        let p = crate::bench::fcc_block(6, l0);
+        p.check_topology().unwrap();
+        let n = p.len();
+        assert!(
+            !n.is_multiple_of(LANES) && n > 1000,
+            "{n}: tails on the scalar path"
+        );
+        let mut m = Mechanics::new(&p, &vec![2400.0; n]);
+        let mut r = Lcg(2026);
+        for i in 0..n {
+            m.a[i] *= 1.0 + 0.1 * r.next();
+            m.b[i] *= 1.0 + 0.1 * r.next();
+            m.c_in[i] = 2.0 * m.mass[i] * 0.2 * 1e6 * r.next();
+            m.c_ex[i] = if i % 3 == 0 { 0.0 } else { m.mass[i] * 1e3 };
+        }
+        let sec = m.second.as_mut().expect("FCC moduli have c ≠ 0");
+        assert_eq!(sec.first_slot, 12);
+        for c in sec.c.iter_mut() {
+            *c *= 1.0 + 0.1 * r.next();
+        }
+        let mut st = State::at_rest(&p.x0);
+        for i in 0..n {
+            st.x[i] += SVector::from_fn(|_, _| 1e-3 * l0 * (r.next() - 0.5));
+            st.v[i] = SVector::from_fn(|_, _| r.next() - 0.5);
+            st.force_prev[i] = SVector::from_fn(|_, _| r.next() - 0.5);
+        }
+        check_model::<3, 18, false, true>(&m, &st);
+        check_model::<3, 18, true, false>(&m, &st);
+        check_model::<3, 18, false, false>(&m, &st);
+        // c is used: the same step without it gives other forces
+        let mut with = st.clone();
+        step::<3, 18, false, false>(&m, &mut with, 1e-9);
+        let mut without = st.clone();
+        m.second = None;
+        step::<3, 18, false, false>(&m, &mut without, 1e-9);
+        let differ = (0..n)
+            .filter(|&i| with.force[i] != without.force[i])
+            .count();
+        assert_eq!(differ, n);
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! The linearised SPLM operator about the reference configuration, matrix-free:
 //! (K·u)_i = −f_i(u) with S_ij = n_ij·(u_j − u_i)/L0_ij, θ_i = Σ_m S_im and
-//! f_i = Σ_j ½((a_i + a_j)·S_ij + b_i·θ_i + b_j·θ_j)·n_ij (MODEL.md §3–4 linearised).
+//! f_i = Σ_j ½((a_i + a_j)·S_ij + b_i·θ_i + b_j·θ_j)·n_ij (MODEL.md §3–4 linearised), with
+//! a + c in place of a in FCC second-neighbour slots (MODEL.md §3 erratum,
+//! `Mechanics::bond_moduli`).
 //! Used for the fundamental period and for the patch test at round-off accuracy.
 
 use super::mechanics::{weighted, Mechanics};
@@ -57,11 +59,12 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
             .enumerate()
             .for_each(|(i, fi)| {
                 let mut acc = SVector::<f64, D>::zeros();
-                for (_, j, il) in mech.bonds(i) {
+                for (k, j, il) in mech.bonds(i) {
                     let (s, n) = this.stretch(u, i, j, il);
+                    let (mi, mj) = mech.bond_moduli(i, j, k);
                     let fb = bond_force(
-                        mech.a[i],
-                        mech.a[j],
+                        mi,
+                        mj,
                         s,
                         dilatation_term(mech.b[i], theta[i]),
                         dilatation_term(mech.b[j], theta[j]),
@@ -73,8 +76,8 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
         self.theta = theta;
     }
 
-    /// Force states F_s,ij = a_i S_ij + b_i θ_i of particle i (linearised), slot by slot,
-    /// after [`Self::internal_forces`].
+    /// Force states F_s,ij = a_i S_ij + b_i θ_i (a_i + c_i in a second-neighbour slot) of
+    /// particle i (linearised), slot by slot, after [`Self::internal_forces`].
     pub fn force_states(
         &self,
         u: &[SVector<f64, D>],
@@ -82,13 +85,13 @@ impl<'a, const D: usize, const K: usize> LinearOperator<'a, D, K> {
     ) -> Vec<(SVector<f64, D>, f64, f64)> {
         self.mech
             .bonds(i)
-            .map(|(_, j, il)| {
+            .map(|(k, j, il)| {
                 let (s, n) = self.stretch(u, i, j, il);
                 (
                     n,
                     1.0 / il,
                     force_state(
-                        self.mech.a[i],
+                        self.mech.slot_modulus(i, k),
                         s,
                         dilatation_term(self.mech.b[i], self.theta[i]),
                     ),

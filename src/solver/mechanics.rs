@@ -1,5 +1,12 @@
 //! Per-particle static data of the step kernel, in structure-of-arrays form, allocated once:
 //! neighbour slots, 1/L0 per slot, micro-moduli, masses and damper coefficients.
+//!
+//! FCC second neighbours (MODEL.md §3 with its erratum): the force state of particle i in
+//! the direction of j is F_s,ij = (a_i + c_i·[j ∈ N_II])·S_ij + b_i·θ_i, so a bond in a
+//! second-neighbour slot has the bond modulus a + c at each end and the bond force
+//! ½((a_i + c_i) + (a_j + c_j))·S_ij + ½(bθ_i + bθ_j). [`Mechanics::second`] holds c and
+//! the first second-neighbour slot; without it (2D, random particles, any body whose c is
+//! all zero) every code path is the one without c, bit for bit.
 
 use crate::aligned::{copied, filled, Aligned, CollectAligned};
 use crate::discretise::{Particles, NONE};
@@ -22,6 +29,9 @@ pub struct Mechanics<const D: usize, const K: usize> {
     pub a: Aligned<f64>,
     /// Micro-modulus b_i (N).
     pub b: Aligned<f64>,
+    /// The second-neighbour modulus c_i and the slots it acts in (FCC, MODEL.md §3 erratum);
+    /// `None` where no particle has a c (2D, random particles).
+    pub second: Option<SecondNeighbours>,
     pub mass: Aligned<f64>,
     pub inv_mass: Aligned<f64>,
     /// Bond damper coefficient C_in,i = 2·m_i·ξ_in·ω_i (3.55); a bond uses ½(C_in,i + C_in,j)
@@ -46,6 +56,7 @@ impl<const D: usize, const K: usize> Default for Mechanics<D, K> {
             slot_inv_l0: None,
             a: Aligned::new(0),
             b: Aligned::new(0),
+            second: None,
             mass: Aligned::new(0),
             inv_mass: Aligned::new(0),
             c_in: Aligned::new(0),
@@ -53,6 +64,27 @@ impl<const D: usize, const K: usize> Default for Mechanics<D, K> {
             dilatation_weight: None,
             slot_end: Aligned::new(0),
         }
+    }
+}
+
+/// The FCC second-neighbour micro-modulus (MODEL.md §3 with its erratum): slots
+/// `first_slot..K` hold second neighbours (N_II), whose bonds have modulus a_i + c_i at
+/// particle i's end.
+#[derive(Clone, Debug)]
+pub struct SecondNeighbours {
+    /// c_i per particle (N; negative for FCC: c = (1/(2√2) − 1)·a).
+    pub c: Aligned<f64>,
+    /// The first second-neighbour slot (12 for FCC: slots 0..12 are the nearest neighbours).
+    pub first_slot: usize,
+}
+
+/// The first second-neighbour slot of a body with K slots whose particles carry a c:
+/// 12 for the FCC lattice (K = 18: 12 nearest neighbours, then 6 second neighbours).
+pub const fn first_second_slot(k: usize) -> Option<usize> {
+    if k == 18 {
+        Some(12)
+    } else {
+        None
     }
 }
 
@@ -98,9 +130,23 @@ pub fn slot_end<const K: usize>(neighbours: &[[u32; K]]) -> Aligned<u8> {
 }
 
 impl<const D: usize, const K: usize> Mechanics<D, K> {
-    /// Model of a body with its micro-moduli (`p.a`, `p.b`) and density; dampers off.
+    /// Model of a body with its micro-moduli (`p.a`, `p.b`, `p.c`) and density; dampers off.
+    ///
+    /// [`Self::second`] is set when any c_i is non-zero (not merely because K = 18: a body
+    /// with 18 slots and no c, such as the simple-cubic block of `tests/concrete_3d.rs`, keeps
+    /// the kernels without c); the second-neighbour slots are then those of
+    /// [`first_second_slot`], which must know K.
     pub fn new(p: &Particles<D, K>, rho: &[f64]) -> Self {
         let n = p.len();
+        let second = p.c.iter().any(|&c| c != 0.0).then(|| {
+            let first_slot = first_second_slot(K).unwrap_or_else(|| {
+                panic!("micro-modulus c is set but {K} slots have no second-neighbour slots")
+            });
+            SecondNeighbours {
+                c: copied(&p.c),
+                first_slot,
+            }
+        });
         // The kernel's unchecked gathers rely on this.
         assert!(
             p.neighbours
@@ -141,6 +187,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             inv_l0,
             a: copied(&p.a),
             b: copied(&p.b),
+            second,
             inv_mass: mass.iter().map(|m| 1.0 / m).collect_aligned(),
             mass,
             c_in: filled(0.0, n),
@@ -169,6 +216,36 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
         self.c_in.iter().any(|&c| c != 0.0)
     }
 
+    /// The bond moduli (at i's end, at j's end) of the bond in slot k of particle i to j:
+    /// (a_i, a_j), or (a_i + c_i, a_j + c_j) in a second-neighbour slot (MODEL.md §3
+    /// erratum). The bond force is `bond_force(mi, mj, S, bθ_i, bθ_j)` and particle i's force
+    /// state `force_state(mi, S, bθ_i)` with (mi, mj) from here.
+    #[inline(always)]
+    pub fn bond_moduli(&self, i: usize, j: usize, k: usize) -> (f64, f64) {
+        match &self.second {
+            Some(s) if k >= s.first_slot => (self.a[i] + s.c[i], self.a[j] + s.c[j]),
+            _ => (self.a[i], self.a[j]),
+        }
+    }
+
+    /// Particle i's own bond modulus in slot k: a_i, or a_i + c_i in a second-neighbour slot.
+    #[inline(always)]
+    pub fn slot_modulus(&self, i: usize, k: usize) -> f64 {
+        match &self.second {
+            Some(s) if k >= s.first_slot => self.a[i] + s.c[i],
+            _ => self.a[i],
+        }
+    }
+
+    /// Panics when the model has second-neighbour moduli: for the kernels that do not
+    /// implement them yet (`what` names the kernel), so that none ignores a c silently.
+    pub fn assert_no_second(&self, what: &str) {
+        assert!(
+            self.second.is_none(),
+            "{what} does not implement the second-neighbour modulus c (MODEL.md §3, FCC)"
+        );
+    }
+
     /// Iterate over the occupied slots of particle i: (slot, neighbour, 1/L0).
     #[inline(always)]
     pub fn bonds(&self, i: usize) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
@@ -182,7 +259,8 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
     /// Upper bound of the spectral radius of M⁻¹K of the linearised model (the induced
     /// block-row-sum norm, a Gershgorin bound), with each block bounded by its 2-norm.
     /// Derivation: f_i = Σ_j ½((a_i+a_j)S_ij + b_i θ_i + b_j θ_j)·n_ij with
-    /// S_ij = n_ij·(u_j − u_i)/L_ij and θ_i = Σ_m w_im·S_im.
+    /// S_ij = n_ij·(u_j − u_i)/L_ij and θ_i = Σ_m w_im·S_im (a + c in place of a in a
+    /// second-neighbour slot, [`Self::bond_moduli`]).
     pub fn max_eigenvalue_bound(&self, x0: &[SVector<f64, D>]) -> f64 {
         let n = self.len();
         // |Σ_m n_im / L_im| and Σ_m 1/L_im per particle
@@ -206,10 +284,11 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
         let mut worst: f64 = 0.0;
         for i in 0..n {
             let mut r = 0.0;
-            let (ai, bi) = (self.a[i], self.b[i].abs());
-            for (_, j, il) in self.bonds(i) {
+            let bi = self.b[i].abs();
+            for (k, j, il) in self.bonds(i) {
                 // a-term: block to u_j and its share of the diagonal block
-                r += 2.0 * axial_stiffness(ai, self.a[j]) * il;
+                let (mi, mj) = self.bond_moduli(i, j, k);
+                r += 2.0 * axial_stiffness(mi, mj).abs() * il;
                 // b_j θ_j term: blocks to the neighbours m of j and to u_j
                 let bj = self.b[j].abs();
                 r += 0.5 * bj * (sum_inv_l[j] + sum_n_over_l[j]);

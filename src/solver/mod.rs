@@ -262,7 +262,8 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 lengths += 1.0 / il;
                 reach = reach.max(self.x0[i].norm() * il);
             }
-            sum += (m.a[i] + n * m.b[i]).abs() * lengths;
+            let c = m.second.as_ref().map_or(0.0, |c| c.c[i].abs());
+            sum += ((m.a[i] + n * m.b[i]).abs() + c) * lengths;
         }
         let s = 1000.0 * f64::EPSILON * reach;
         0.25 * s * s * sum
@@ -446,7 +447,8 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     }
 
     /// Elastic energy stored in the bonds at the current positions,
-    /// U = ¼·Σ_i Σ_j L0,ij·S_ij·F_s,ij (so that ∂U/∂L_ij = F_b,ij; see MODEL.md §7).
+    /// U = ¼·Σ_i Σ_j L0,ij·S_ij·F_s,ij (so that ∂U/∂L_ij = F_b,ij; see MODEL.md §7), with
+    /// the FCC second-neighbour term ¼·c_i·Σ_{j∈N_II} L0,ij·S_ij² (MODEL.md §3 erratum).
     pub fn internal_energy_now(&self) -> f64 {
         if let Some(model) = &self.inelastic {
             return model.internal_energy(&self.mech, &self.state.x);
@@ -458,14 +460,25 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 let mut sum_s = 0.0;
                 let mut sum_s2_l = 0.0;
                 let mut sum_s_l = 0.0;
+                // Σ over second-neighbour slots of S²·L0 (FCC: their modulus is a + c)
+                let mut sum_s2_l_second = 0.0;
                 let w = m.weights(i);
                 for (k, j, il) in m.bonds(i) {
                     let s = crate::model::stretch::total_stretch((x[j] - x[i]).norm(), il);
                     sum_s += mechanics::weighted(w, k, s);
                     sum_s2_l += s * s / il;
                     sum_s_l += s / il;
+                    if m.second.as_ref().is_some_and(|c| k >= c.first_slot) {
+                        sum_s2_l_second += s * s / il;
+                    }
                 }
-                crate::model::force_state::particle_energy(m.a[i], m.b[i], sum_s, sum_s2_l, sum_s_l)
+                let u = crate::model::force_state::particle_energy(
+                    m.a[i], m.b[i], sum_s, sum_s2_l, sum_s_l,
+                );
+                match &m.second {
+                    None => u,
+                    Some(c) => u + 0.25 * c.c[i] * sum_s2_l_second,
+                }
             })
             .sum()
     }
