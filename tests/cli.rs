@@ -166,6 +166,36 @@ fn bench_prints_one_json_line() {
     assert!(v["particle_steps_per_s"].as_f64().unwrap() > 0.0);
 }
 
+/// `bench --dim 3` times the elastic kernel on an FCC cube; the 2D-only concrete kernels
+/// are refused with the flag and its value.
+#[test]
+fn bench_dim_3_runs_the_fcc_elastic_kernel_only() {
+    let o = sppm(&["bench", "--dim", "3", "--particles", "3000", "--steps", "5"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&o.stdout).trim()).unwrap();
+    assert_eq!(v["lattice"], "fcc");
+    assert_eq!(v["model"], "elastic");
+    // 4N³ + 6N² + 3N + 1 with N = 9, the cube nearest 3000
+    assert_eq!(v["particles"], 3430);
+    assert_eq!(
+        v["bytes_per_particle"].as_u64(),
+        Some(sppm::discretise::bytes_per_particle(3, 18) as u64)
+    );
+    for model in ["tension", "full"] {
+        let o = sppm(&["bench", "--dim", "3", "--model", model, "--steps", "1"]);
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains(&format!("--model {model}")) && err.contains("--dim 3"),
+            "{err}"
+        );
+    }
+    let o = sppm(&["bench", "--dim", "4"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--dim 4"));
+}
+
 #[test]
 fn bad_input_stops_with_the_key_and_a_non_zero_status() {
     let o = sppm(&[

@@ -664,6 +664,16 @@ pub(crate) mod avx {
             let b = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(1)), r(3), 1); // x1 y1 x3 y3
             out[0] = _mm256_unpacklo_pd(a, b);
             out[1] = _mm256_unpackhi_pd(a, b);
+        } else if D == 3 && std::mem::size_of::<SVector<f64, D>>() == 24 {
+            // x, y as in 2D (one 16-byte load per row, two shuffles), z one by one
+            let p = x.as_ptr() as *const f64;
+            let r = |l: usize| _mm_loadu_pd(p.add(3 * j[l]));
+            let a = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(0)), r(2), 1); // x0 y0 x2 y2
+            let b = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(1)), r(3), 1); // x1 y1 x3 y3
+            out[0] = _mm256_unpacklo_pd(a, b);
+            out[1] = _mm256_unpackhi_pd(a, b);
+            let z = |l: usize| *p.add(3 * j[l] + 2);
+            out[2] = _mm256_set_pd(z(3), z(2), z(1), z(0));
         } else {
             for (c, o) in out.iter_mut().enumerate() {
                 *o = _mm256_set_pd(
