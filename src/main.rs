@@ -180,7 +180,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 }
             };
             if sc.discretisation.dim() == 3 {
-                check_solid(&sc, mem)?;
+                check_solid(&sc, mem, &stage)?;
             } else if sppm::run::prepare::slots_of(&sc) == sppm::discretise::random::SLOTS_2D {
                 check::<{ sppm::discretise::random::SLOTS_2D }>(&sc, mem, &stage)?;
             } else {
@@ -259,29 +259,54 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// `sppm check` of a 3D scene: the FCC body, its memory, its boundary treatment.
-fn check_solid(sc: &Scene, mem: f64) -> anyhow::Result<()> {
-    let (p, body) = sppm::run::solid::fcc_body(sc)?;
+/// `sppm check` of a 3D scene: the FCC body, its memory, its boundary treatment, T1 and the
+/// time step, and the run time from a few timed steps.
+fn check_solid(sc: &Scene, mem: f64, stage: &dyn Fn(&str)) -> anyhow::Result<()> {
+    let mut p = sppm::run::solid::prepare_solid(sc, stage)?;
+    stage("timing a few steps of the kernel");
+    let mut sim = sppm::run::execute::simulation_of(&mut p);
+    let calib = 20.min(p.steps.max(1));
+    let t = std::time::Instant::now();
+    for _ in 0..calib {
+        sim.advance(None);
+    }
+    let per_step = t.elapsed().as_secs_f64() / calib as f64;
     say!("scene            {}", sc.name());
     say!(
         "lattice          fcc (3D), rotation {:?}°",
         sc.discretisation.rotation_deg.angles()
     );
-    say!("particles        {}", p.len());
-    say!("bonds            {}", p.bonds());
-    say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-    let m = &body.moduli;
+    say!("particles        {}", p.model.particles.len());
+    say!("bonds            {}", p.model.particles.bonds());
     say!(
-        "surface          {}: {} bulk particles, {} fitted (a, b, c), {} fitted (a, b), {} unfitted; largest residual {:.4}; particles' volume {:+.2e} of the body's",
-        body.method,
-        m.bulk,
-        m.fitted,
-        m.fitted_without_c,
-        m.unfitted,
-        m.max_residual,
-        body.particle_volume / body.body_volume - 1.0
+        "groups           {}",
+        p.model
+            .groups
+            .iter()
+            .map(|g| format!("{} ({})", g.name, g.members.len()))
+            .collect::<Vec<_>>()
+            .join(", ")
     );
-    say!("run              not available yet in 3D (groups, supports and the run on a 3D body come next)");
+    say!("fundamental T1   {:.6e} s", p.fundamental.period);
+    say!("stable dt        {:.6e} s", p.stable.dt_stable);
+    say!("time step dt     {:.6e} s", p.dt);
+    say!("t_end            {:.6e} s", p.t_end);
+    say!("steps            {}", p.steps);
+    say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+    say!(
+        "run time (est.)  {:.1} s on {} threads",
+        per_step * p.steps as f64,
+        rayon::current_num_threads()
+    );
+    let sf = &p.model.surface;
+    say!(
+        "surface          {}: {} boundary particles, {} fitted; largest residual {:.4}; particles' volume {:+.2e} of the body's",
+        sf.method,
+        sf.boundary_particles,
+        sf.corrected,
+        sf.max_residual,
+        sf.particle_volume / sf.body_volume - 1.0
+    );
     Ok(())
 }
 

@@ -10,7 +10,9 @@
 use super::{drop_isolated, Particles, NONE};
 use crate::geometry::Shape3;
 use crate::model::dimension::{Dim, Dimension};
-use crate::model::micro_modulus::{fcc, fcc_volume, fit_fcc, FccBond};
+use crate::model::micro_modulus::{
+    fcc_volume, fit_fcc_weighted, fit_weighted_3d, FccBond, FccModuli,
+};
 use crate::scene::Plane;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -138,6 +140,7 @@ impl FccLattice {
                 l0[p][k] = if k < SECOND { self.spacing } else { second };
             }
         }
+        unbond_flat_particles(&x0, &mut neighbours, &reverse);
         let mut particles = Particles::new(
             x0,
             vec![fcc_volume(self.spacing); n],
@@ -146,8 +149,52 @@ impl FccLattice {
             l0,
             self.spacing,
         );
+        // θ_i = Σ_m (L0,im/ℓ_i)·S_im: conservative with bonds of two lengths (docs/fcc.md)
+        particles.weighted_dilatation = true;
         drop_isolated(&mut particles);
         particles
+    }
+}
+
+/// Remove every bond of a particle whose bonds do not span space (fewer than three, or all
+/// in one plane: a corner or edge particle of a rotated lattice), repeatedly, since its
+/// neighbours may lose their spanning set in turn. Such a particle moves across its bonds
+/// without resistance (a zero-stiffness mode: T1 and the static solves fail on it);
+/// [`drop_isolated`] then removes it, and the clipped cells give its volume to the
+/// particles around it.
+fn unbond_flat_particles(
+    x0: &[Vector3<f64>],
+    neighbours: &mut [[u32; SLOTS]],
+    reverse: &[[u8; SLOTS]],
+) {
+    let spans = |i: usize, nb: &[[u32; SLOTS]]| {
+        let mut m = Matrix3::zeros();
+        for &j in nb[i].iter().filter(|&&j| j != NONE) {
+            let e = (x0[j as usize] - x0[i]).normalize();
+            m += e * e.transpose();
+        }
+        // the smallest eigenvalue of Σ e·eᵀ: 0 for bonds in a plane
+        m.symmetric_eigenvalues().min() > 1e-6
+    };
+    let mut todo: Vec<usize> = (0..x0.len()).collect();
+    while !todo.is_empty() {
+        let mut next = Vec::new();
+        for i in todo {
+            if neighbours[i].iter().all(|&j| j == NONE) || spans(i, neighbours) {
+                continue;
+            }
+            for k in 0..SLOTS {
+                let j = neighbours[i][k];
+                if j != NONE {
+                    neighbours[j as usize][reverse[i][k] as usize] = NONE;
+                    neighbours[i][k] = NONE;
+                    next.push(j as usize);
+                }
+            }
+        }
+        next.sort_unstable();
+        next.dedup();
+        todo = next;
     }
 }
 
@@ -168,26 +215,42 @@ pub struct ModuliReport {
     pub max_residual: f64,
 }
 
+/// The bulk constants (a, b, c) of an FCC particle with nearest spacing `l0` under the
+/// weighted dilatation the lattice runs with (MODEL.md §3 with its erratum; the closed forms
+/// (4.8) hold for the source's unweighted θ, see [`fit_fcc_weighted`]): the exact fit of the
+/// 18 bonds and the full cell to the isotropic D.
+pub fn bulk_moduli(e: f64, nu: f64, l0: f64) -> FccModuli {
+    let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
+    let bonds: Vec<FccBond> = STEPS
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let v = Vector3::new(s[0] as f64, s[1] as f64, s[2] as f64);
+            (v.normalize(), v.norm() * l0 / 2f64.sqrt(), k >= SECOND)
+        })
+        .collect();
+    fit_fcc_weighted(&bonds, fcc_volume(l0), l0, &d)
+        .expect("the bulk FCC particle spans D")
+        .moduli
+}
+
 /// Set a, b, c of every particle of an FCC body for the isotropic (E, ν) (MODEL.md §3 with
 /// its erratum) and its volume `p.volume` (the full cell, or the cell clipped to the body,
-/// `voronoi3::fcc_clipped_volumes`): the bulk constants [`fcc`] scaled by the particle's
-/// volume fraction for a particle with all 18 bonds; for one with
-/// missing bonds the least-squares (a, b, c) of its own bonds and volume against D (3.20,
-/// [`fit_fcc`]), or (a, b) with c = 0 where that fit fails, or the bulk constants where no
-/// fit exists (scaled by the volume fraction).
+/// `voronoi3::fcc_clipped_volumes`), for the weighted dilatation θ_i = Σ_m (L0,im/ℓ_i)·S_im
+/// the lattice runs with ([`FccLattice::fill`] sets it): [`bulk_moduli`] scaled by the
+/// particle's volume fraction for a particle with all 18 bonds; for one with missing bonds
+/// the least-squares (a, b, c) of its own bonds and volume against D (3.20,
+/// [`fit_fcc_weighted`]), or (a, b) with c = 0 where that fit fails, or the bulk constants
+/// scaled by the volume fraction where no fit exists.
 pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliReport {
     let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
     let mut report = ModuliReport::default();
     for i in 0..p.len() {
-        let bulk = fcc(e, nu, p.length[i]);
-        let (mut a, mut b, mut c) = (bulk.a, bulk.b, bulk.c);
+        let ell = p.length[i];
+        let bulk = bulk_moduli(e, nu, p.spacing);
+        let fraction = p.volume[i] / fcc_volume(p.spacing);
+        let (mut a, mut b, mut c) = (bulk.a * fraction, bulk.b * fraction, bulk.c * fraction);
         if p.bond_count(i) == SLOTS {
-            // a clipped cell with every bond: the fit is the bulk constants × the volume
-            // fraction exactly (D_i is linear in 1/ΔV_i)
-            let fraction = p.volume[i] / fcc_volume(p.length[i]);
-            if fraction != 1.0 {
-                (a, b, c) = (a * fraction, b * fraction, c * fraction);
-            }
             report.bulk += 1;
         } else {
             let bonds: Vec<FccBond> = (0..SLOTS)
@@ -197,20 +260,17 @@ pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliRepo
                     ((p.x0[j] - p.x0[i]).normalize(), p.l0[i][k], k >= SECOND)
                 })
                 .collect();
-            if let Some(f) = fit_fcc(&bonds, p.volume[i], &d) {
+            if let Some(f) = fit_fcc_weighted(&bonds, p.volume[i], ell, &d) {
                 (a, b, c) = (f.moduli.a, f.moduli.b, f.moduli.c);
                 report.fitted += 1;
                 report.max_residual = report.max_residual.max(f.residual);
             } else {
                 let plain: Vec<_> = bonds.iter().map(|&(n, l, _)| (n, l)).collect();
-                if let Some(f) = <Dim<3> as Dimension<3>>::fit(&plain, p.volume[i], &d) {
+                if let Some(f) = fit_weighted_3d(&plain, p.volume[i], ell, &d) {
                     (a, b, c) = (f.moduli.a, f.moduli.b, 0.0);
                     report.fitted_without_c += 1;
                     report.max_residual = report.max_residual.max(f.residual);
                 } else {
-                    // the bulk constants for the particle's own (possibly clipped) volume
-                    let fraction = p.volume[i] / fcc_volume(p.length[i]);
-                    (a, b, c) = (a * fraction, b * fraction, c * fraction);
                     report.unfitted += 1;
                 }
             }

@@ -13,13 +13,15 @@ pub struct Group {
     pub members: Vec<u32>,
 }
 
-/// Outward normal and tangent of an edge.
-fn edge_frame(edge: Edge) -> (Vector2<f64>, Vector2<f64>) {
+/// Outward normal and tangent of an edge in the plane; `None` for the faces normal to z
+/// (3D only; validation refuses them in 2D).
+fn edge_frame(edge: Edge) -> Option<(Vector2<f64>, Vector2<f64>)> {
     match edge {
-        Edge::Top => (Vector2::new(0.0, 1.0), Vector2::new(1.0, 0.0)),
-        Edge::Bottom => (Vector2::new(0.0, -1.0), Vector2::new(1.0, 0.0)),
-        Edge::Right => (Vector2::new(1.0, 0.0), Vector2::new(0.0, 1.0)),
-        Edge::Left => (Vector2::new(-1.0, 0.0), Vector2::new(0.0, 1.0)),
+        Edge::Top => Some((Vector2::new(0.0, 1.0), Vector2::new(1.0, 0.0))),
+        Edge::Bottom => Some((Vector2::new(0.0, -1.0), Vector2::new(1.0, 0.0))),
+        Edge::Right => Some((Vector2::new(1.0, 0.0), Vector2::new(0.0, 1.0))),
+        Edge::Left => Some((Vector2::new(-1.0, 0.0), Vector2::new(0.0, 1.0))),
+        Edge::Front | Edge::Back => None,
     }
 }
 
@@ -121,7 +123,9 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
             x.x >= min[0] - eps && x.x <= max[0] + eps && x.y >= min[1] - eps && x.y <= max[1] + eps
         }),
         Selection::Edge { edge, rows } => {
-            let (n, _) = edge_frame(*edge);
+            let Some((n, _)) = edge_frame(*edge) else {
+                return Vec::new();
+            };
             let hmax =
                 p.x0.iter()
                     .map(|x| x.dot(&n))
@@ -153,13 +157,92 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
         } => {
             // a particle is under the strip when it lies within `depth` of the body's own
             // surface at its tangent position (so a curved surface, a disc's, is followed)
-            let (n, t) = edge_frame(*edge);
+            let Some((n, t)) = edge_frame(*edge) else {
+                return Vec::new();
+            };
             let half = 0.5 * width + eps;
             let depth = depth.unwrap_or(2.0 * pitch);
             pick(&|x| {
                 let s = x.dot(&t);
                 (s - centre).abs() <= half
                     && boundary_height(shape, n, t, s).is_some_and(|h| x.dot(&n) >= h - depth)
+            })
+        }
+    }
+}
+
+/// Select the members of a group of a 3D body (`solid`; `section`: its 2D section where it
+/// has one, a prism's or a cylinder's along z). Empty selections are reported by the caller.
+///
+/// - `edge` takes the faces of the body's bounding box (left/right: x, bottom/top: y,
+///   front/back: z): the particles within `rows` lattice-plane pitches L0/√2 of the face
+///   (exactly `rows` planes of the unrotated lattice at any offset);
+/// - `strip` follows the section as in 2D (a platen of `width` at `centre` along the edge,
+///   `depth` below the section's own surface), through the whole length along z: the
+///   bearing strips of a split cylinder; a body without a section along z selects nothing;
+/// - `box` and `nearest` take three components.
+pub fn select_3d<const K: usize>(
+    sel: &Selection,
+    p: &Particles<3, K>,
+    solid: &crate::geometry::Shape3,
+    section: Option<&Shape2>,
+) -> Vec<u32> {
+    use nalgebra::Vector3;
+    let pitch = p.spacing / 2f64.sqrt();
+    let eps = 1e-9 * p.spacing;
+    let pick = |f: &dyn Fn(&Vector3<f64>) -> bool| -> Vec<u32> {
+        (0..p.len())
+            .filter(|&i| f(&p.x0[i]))
+            .map(|i| i as u32)
+            .collect()
+    };
+    let coords = |v: &[f64]| Vector3::new(v[0], v[1], v.get(2).copied().unwrap_or(0.0));
+    match sel {
+        Selection::All => (0..p.len() as u32).collect(),
+        Selection::Nearest { point } => {
+            let q = coords(point);
+            (0..p.len())
+                .min_by(|&a, &b| {
+                    (p.x0[a] - q)
+                        .norm_squared()
+                        .total_cmp(&(p.x0[b] - q).norm_squared())
+                })
+                .map(|i| vec![i as u32])
+                .unwrap_or_default()
+        }
+        Selection::Box { min, max } => {
+            let (lo, hi) = (coords(min), coords(max));
+            pick(&|x| (0..3).all(|d| x[d] >= lo[d] - eps && x[d] <= hi[d] + eps))
+        }
+        Selection::Edge { edge, rows } => {
+            let (lo, hi) = solid.bounding_box();
+            let (axis, sign, face) = match edge {
+                Edge::Left => (0, -1.0, lo.x),
+                Edge::Right => (0, 1.0, hi.x),
+                Edge::Bottom => (1, -1.0, lo.y),
+                Edge::Top => (1, 1.0, hi.y),
+                Edge::Front => (2, -1.0, lo.z),
+                Edge::Back => (2, 1.0, hi.z),
+            };
+            let reach = *rows as f64 * pitch - eps;
+            pick(&|x| sign * (face - x[axis]) < reach)
+        }
+        Selection::Strip {
+            edge,
+            width,
+            centre,
+            depth,
+        } => {
+            let (Some((n, t)), Some(section)) = (edge_frame(*edge), section) else {
+                return Vec::new();
+            };
+            let half = 0.5 * width + eps;
+            let depth = depth.unwrap_or(2.0 * pitch);
+            pick(&|x| {
+                let q = Vector2::new(x.x, x.y);
+                let s = q.dot(&t);
+                (s - centre).abs() <= half
+                    && boundary_height(section, n, t, s).is_some_and(|h| q.dot(&n) >= h - depth)
             })
         }
     }

@@ -101,6 +101,61 @@ pub fn fcc_basis(bonds: &[FccBond], volume: f64) -> (Matrix6<f64>, Matrix6<f64>,
     (a_m, b_m, c_m)
 }
 
+/// [`fcc_basis`] with the weighted dilatation θ_i = Σ_m (L0,im/ℓ_i)·S_im (ℓ_i the
+/// particle's shortest bond; [`crate::model::dimension::stiffness_basis_weighted`]). The FCC
+/// lattice runs with it: with the source's θ = Σ S, bonds of two lengths make the stiffness
+/// unsymmetric (docs/fcc.md), as for random particles (docs/sppm.md).
+pub fn fcc_basis_weighted(
+    bonds: &[FccBond],
+    volume: f64,
+    ell: f64,
+) -> (Matrix6<f64>, Matrix6<f64>, Matrix6<f64>) {
+    use crate::model::dimension::{stiffness_basis_weighted, Voigt6};
+    let all: Vec<(Vector3<f64>, f64)> = bonds.iter().map(|&(n, l0, _)| (n, l0)).collect();
+    let second: Vec<(Vector3<f64>, f64)> = bonds
+        .iter()
+        .filter(|b| b.2)
+        .map(|&(n, l0, _)| (n, l0))
+        .collect();
+    let (a_m, b_m) = stiffness_basis_weighted::<3, 6, Voigt6>(&all, volume, Some(ell));
+    let (c_m, _) = stiffness_basis_weighted::<3, 6, Voigt6>(&second, volume, Some(ell));
+    (a_m, b_m, c_m)
+}
+
+/// Least-squares (a, b, c) of an FCC particle with the weighted dilatation
+/// ([`fcc_basis_weighted`]); `None` as [`fit_fcc`]. For a bulk particle (all 18 bonds) the
+/// fit is exact: A, B and C are cubic and span the isotropic D.
+pub fn fit_fcc_weighted(
+    bonds: &[FccBond],
+    volume: f64,
+    ell: f64,
+    d: &Matrix6<f64>,
+) -> Option<FccFit> {
+    let (a_m, b_m, c_m) = fcc_basis_weighted(bonds, volume, ell);
+    let ([a, b, c], residual) = least_squares(&[a_m, b_m, c_m], d, |x| x[0] + x[2] > 0.0)?;
+    Some(FccFit {
+        moduli: FccModuli { a, b, c },
+        residual,
+    })
+}
+
+/// Least-squares (a, b) with c = 0 of a 3D particle with the weighted dilatation (an FCC
+/// particle whose (a, b, c) fit fails).
+pub fn fit_weighted_3d(
+    bonds: &[(Vector3<f64>, f64)],
+    volume: f64,
+    ell: f64,
+    d: &Matrix6<f64>,
+) -> Option<crate::model::dimension::Fit> {
+    use crate::model::dimension::{stiffness_basis_weighted, Voigt6};
+    let (a_m, b_m) = stiffness_basis_weighted::<3, 6, Voigt6>(bonds, volume, Some(ell));
+    let ([a, b], residual) = least_squares(&[a_m, b_m], d, |_| true)?;
+    Some(crate::model::dimension::Fit {
+        moduli: crate::model::dimension::MicroModuli { a, b },
+        residual,
+    })
+}
+
 /// Result of the least-squares (a, b, c) fit of an FCC particle.
 #[derive(Clone, Copy, Debug)]
 pub struct FccFit {

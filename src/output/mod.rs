@@ -5,6 +5,7 @@
 pub mod csv;
 pub mod fields;
 pub mod plots;
+pub mod section;
 pub mod vtk;
 
 use crate::fsio;
@@ -61,9 +62,12 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
         plots::force_displacement(outcome, f)
     })?;
     let o = &outcome.scene.output;
+    // a 3D run's maps draw its section (output::section)
+    let view = (outcome.dim == 3).then(|| section::section_view(outcome));
+    let mapped = view.as_ref().unwrap_or(outcome);
     if outcome.damage.is_some() {
         put("crack_map.svg".into(), &|f| {
-            plots::crack_map(outcome, o.crack_map_scale, f)
+            plots::crack_map(mapped, o.crack_map_scale, f)
         })?;
     }
     for (k, field) in outcome.fields.iter().enumerate() {
@@ -74,7 +78,7 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
     }
     if o.map {
         put("particle_map.svg".into(), &|f| {
-            plots::particle_map(outcome, o.field, o.deformed_scale, f)
+            plots::particle_map(mapped, o.field, o.deformed_scale, f)
         })?;
     }
     if o.vtk {

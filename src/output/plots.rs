@@ -271,7 +271,7 @@ impl Frame {
             .configure_mesh()
             .disable_mesh()
             .x_desc(x_desc)
-            .y_desc("y (mm)")
+            .y_desc(format!("{} (mm)", o.axes[1]))
             .draw()
             .map_err(err)?;
         Ok(chart)
@@ -362,7 +362,7 @@ fn value_map(
     let root = SVGBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
     let (main, bar) = root.split_horizontally(width - 140);
-    let mut chart = frame.chart(&main, o, label, scale, "x (mm)".into(), 40)?;
+    let mut chart = frame.chart(&main, o, label, scale, format!("{} (mm)", o.axes[0]), 40)?;
     let radius = frame.radius;
     frame.fill(
         &mut chart,
@@ -440,7 +440,8 @@ pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
         "tensile damage",
         scale,
         format!(
-            "x (mm)   —   red: w_t (grey 0 → dark red 1; {cracked} with w_t ≥ 0.99)   ×: w_c ≥ 0.5 ({crushed})   blue ring: yielded ({yielded})"
+            "{} (mm)   —   red: w_t (grey 0 → dark red 1; {cracked} with w_t ≥ 0.99)   ×: w_c ≥ 0.5 ({crushed})   blue ring: yielded ({yielded})",
+            o.axes[0]
         ),
         60,
     )?;

@@ -11,10 +11,10 @@ use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
 use crate::scene::{Scene, SolverMethod};
-use crate::solver::concrete::Concrete;
+use crate::solver::concrete::{Concrete, ParticleDamage};
 use crate::solver::mechanics::{weighted, Mechanics};
 use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
-use nalgebra::{SMatrix, SVector, Vector2};
+use nalgebra::{SMatrix, SVector};
 use std::time::Instant;
 
 /// Particle stresses (3.18) at positions x, in D dimensions: σ_i = (1/(2ΔV_i))·Σ_j
@@ -65,10 +65,20 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
         .build()
         .map_err(|e| RunError::Setup(format!("cannot start {threads} threads: {e}")))?;
     pool.install(|| {
-        if slots_of(scene) == random::SLOTS_2D {
-            run_prepared::<{ random::SLOTS_2D }>(prepare_with(scene, &|_| {})?, opts, threads)
+        if scene.discretisation.dim() == 3 {
+            let p = super::solid::prepare_solid(scene, &|_| {})?;
+            run_prepared(p, opts, threads, &simulation_of, &stress_3d)
+        } else if slots_of(scene) == random::SLOTS_2D {
+            let p = prepare_with::<{ random::SLOTS_2D }>(scene, &|_| {})?;
+            run_prepared(p, opts, threads, &build_simulation, &stress_2d)
         } else {
-            run_prepared::<6>(prepare_with(scene, &|_| {})?, opts, threads)
+            run_prepared(
+                prepare_with::<6>(scene, &|_| {})?,
+                opts,
+                threads,
+                &build_simulation,
+                &stress_2d,
+            )
         }
     })
 }
@@ -76,18 +86,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
 /// The simulation of a prepared scene, at rest, taking over the model's arrays (no copy);
 /// with `[concrete]`, the damage and plasticity kernel is on.
 pub fn build_simulation<const K: usize>(p: &mut Prepared<K>) -> Simulation<2, K> {
-    let integration = Integration {
-        dt: p.dt,
-        lagged_forces: p.model.scene.solver.force_lag == crate::scene::ForceLag::Previous,
-        ramp: p.model.scene.loading.ramp,
-        t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
-    };
-    let mut sim = Simulation::new(
-        p.model.particles.x0.clone(),
-        std::mem::take(&mut p.model.mech),
-        std::mem::take(&mut p.model.prescribed),
-        integration,
-    );
+    let mut sim = simulation_of(p);
     if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
         let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
         let mut c: Concrete<2, K> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
@@ -99,10 +98,71 @@ pub fn build_simulation<const K: usize>(p: &mut Prepared<K>) -> Simulation<2, K>
     sim
 }
 
-fn run_prepared<const K: usize>(
-    mut p: Prepared<K>,
+/// The elastic simulation of a prepared scene (2D or 3D), at rest, taking over the model's
+/// arrays.
+pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> Simulation<D, K> {
+    let integration = Integration {
+        dt: p.dt,
+        lagged_forces: p.model.scene.solver.force_lag == crate::scene::ForceLag::Previous,
+        ramp: p.model.scene.loading.ramp,
+        t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
+    };
+    Simulation::new(
+        p.model.particles.x0.clone(),
+        std::mem::take(&mut p.model.mech),
+        std::mem::take(&mut p.model.prescribed),
+        integration,
+    )
+}
+
+/// What a run shows of each particle at its end: the stress (6 Voigt components) and, with
+/// damage, each particle's damage.
+type Recovered = (Vec<[f64; 6]>, Option<Vec<ParticleDamage>>);
+
+/// The recovered stress D_i·ε_i of a 2D run (run::stress_recovery), not (3.18).
+fn stress_2d<const K: usize>(p: &Prepared<K>, sim: &Simulation<2, K>) -> Recovered {
+    let x = &sim.state.x;
+    let (stress, damage) = match &sim.inelastic {
+        Some(model) => {
+            let damage = model.damage();
+            let intact = |j: usize| {
+                let d = &damage[j];
+                d.wt == 0.0 && d.wc == 0.0 && !d.yielded
+            };
+            let strain = stress_recovery::recovered_strain(
+                &p.model,
+                x,
+                model.particle_strain(&sim.mech, x),
+                &intact,
+            );
+            (
+                stress_recovery::recovered_stress(&p.model, &strain),
+                Some(damage),
+            )
+        }
+        None => (stress_recovery::elastic_stress(&p.model, x), None),
+    };
+    (stress.iter().map(voigt6).collect(), damage)
+}
+
+/// The stress of a 3D (elastic) run: D·ε_i with ε_i each particle's least-squares strain of
+/// its own bond stretches (MODEL.md §7, §13), as in the bulk of 2D.
+fn stress_3d<const K: usize>(p: &Prepared<K, 3>, sim: &Simulation<3, K>) -> Recovered {
+    (
+        stress_recovery::own_stress_3d(&p.model, &sim.state.x)
+            .iter()
+            .map(voigt6)
+            .collect(),
+        None,
+    )
+}
+
+fn run_prepared<const K: usize, const D: usize>(
+    mut p: Prepared<K, D>,
     opts: &RunOptions,
     threads: usize,
+    simulate: &dyn Fn(&mut Prepared<K, D>) -> Simulation<D, K>,
+    recover: &dyn Fn(&Prepared<K, D>, &Simulation<D, K>) -> Recovered,
 ) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let method = p.model.scene.solver.method;
@@ -116,7 +176,7 @@ fn run_prepared<const K: usize>(
             .dt
             .unwrap_or(p.model.scene.solver.safety * p.stable.dt_stable);
     }
-    let mut sim = build_simulation(&mut p);
+    let mut sim = simulate(&mut p);
     let empty_probe = Probe {
         members: vec![],
         component: 1,
@@ -154,33 +214,14 @@ fn run_prepared<const K: usize>(
         }
     };
     let wall = start.elapsed().as_secs_f64();
-    let x = sim.state.x.clone();
-    let displacement: Vec<Vector2<f64>> = x
+    let displacement: Vec<[f64; 3]> = sim
+        .state
+        .x
         .iter()
         .zip(&p.model.particles.x0)
-        .map(|(a, b)| a - b)
+        .map(|(a, b)| point3(&(a - b)))
         .collect();
-    // the recovered stress D_i·ε_i (run::stress_recovery), not (3.18)
-    let (stress, damage) = match &sim.inelastic {
-        Some(model) => {
-            let damage = model.damage();
-            let intact = |j: usize| {
-                let d = &damage[j];
-                d.wt == 0.0 && d.wc == 0.0 && !d.yielded
-            };
-            let strain = stress_recovery::recovered_strain(
-                &p.model,
-                &x,
-                model.particle_strain(&sim.mech, &x),
-                &intact,
-            );
-            (
-                stress_recovery::recovered_stress(&p.model, &strain),
-                Some(damage),
-            )
-        }
-        None => (stress_recovery::elastic_stress(&p.model, &x), None),
-    };
+    let (stress, damage) = recover(&p, &sim);
     let summary = summarise(
         &p,
         &Finished {
@@ -206,23 +247,24 @@ fn run_prepared<const K: usize>(
         }),
         moduli_residual: p.model.random.as_ref().map(|r| r.moduli.residual.clone()),
         records,
-        dim: 2,
+        dim: D,
         x0: p.model.particles.x0.iter().map(point3).collect(),
-        displacement: displacement.iter().map(point3).collect(),
-        stress: stress.iter().map(voigt6).collect(),
+        displacement,
+        stress,
         damage,
         groups: p.model.groups.clone(),
         scene: p.model.scene.clone(),
         fields: p.model.fields.clone(),
+        axes: ["x", "y"],
     };
     Ok(outcome)
 }
 
 /// The explicit run to t_end with probe records (and the wall time at each), stopping at an
 /// instability, or after the peak with `loading.stop_after_peak` (then `true`).
-fn run_explicit<const K: usize>(
-    sim: &mut Simulation<2, K>,
-    p: &Prepared<K>,
+fn run_explicit<const K: usize, const D: usize>(
+    sim: &mut Simulation<D, K>,
+    p: &Prepared<K, D>,
     probe: &Probe,
     opts: &RunOptions,
     start: Instant,

@@ -64,8 +64,8 @@ pub struct ModuliFit {
 }
 
 /// A discretised, assembled specimen ready to run: the model plus its dynamics.
-pub struct Prepared<const K: usize = 6> {
-    pub model: Model<K>,
+pub struct Prepared<const K: usize = 6, const D: usize = 2> {
+    pub model: Model<K, D>,
     pub fundamental: modal::Fundamental,
     pub stable: StableStep,
     pub dt: f64,
@@ -94,13 +94,13 @@ pub fn estimated_memory(scene: &Scene) -> f64 {
 
 /// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step), in
 /// `K` bond slots (6: the hexagonal lattice; [`random::SLOTS_2D`]: random particles).
-pub struct Model<const K: usize = 6> {
+pub struct Model<const K: usize = 6, const D: usize = 2> {
     pub scene: Scene,
-    pub particles: Particles<2, K>,
+    pub particles: Particles<D, K>,
     pub groups: Vec<groups::Group>,
     pub prescribed: Vec<Prescribed>,
-    pub constrained: Vec<[bool; 2]>,
-    pub mech: Mechanics<2, K>,
+    pub constrained: Vec<[bool; D]>,
+    pub mech: Mechanics<D, K>,
     pub bulk: MicroModuli,
     pub surface: SurfaceCorrection,
     /// The scene's random fields sampled at the particles (MODEL.md §12).
@@ -197,7 +197,7 @@ fn assemble<const K: usize>(
     let m = &scene.material;
     if d.dim() == 3 {
         return Err(RunError::Setup(format!(
-            "discretisation.lattice = \"fcc\": 3D runs are not available yet. The FCC lattice, its bodies (body.shape = \"{}\") and its micro-moduli are built, and `sppm check` reports them; groups, supports and the run on a 3D body come next (issue \"3D\")",
+            "discretisation.lattice = \"fcc\" (body.shape = \"{}\") is a 3D scene: its model is assembled by run::solid::prepare_model_solid / prepare_solid, not by the 2D assembly",
             scene.body.name()
         )));
     }
@@ -236,61 +236,17 @@ fn assemble<const K: usize>(
 
     // Groups, supports and loading.
     let n = particles.len();
-    let mut groups = Vec::new();
-    let mut constrained = vec![[false; 2]; n];
-    let mut amplitude: Vec<[Option<(f64, String)>; 2]> = vec![[None, None]; n];
     let (body_lo, body_hi) = shape.bounding_box();
-    for g in &scene.groups {
-        let members = groups::select(&g.select, &particles, &shape);
-        if members.is_empty() {
-            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
-                key: format!("groups.{}.select", g.name),
-                value: g.select.scene_text(),
-                allowed: format!(
-                    "a selection that contains at least one particle; the body spans x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m",
-                    body_lo.x, body_hi.x, body_lo.y, body_hi.y
-                ),
-            }));
-        }
-        let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
-        if let Some(l) = &g.load {
-            entries.push((l.component.index(), l.delta()));
-        }
-        for &i in &members {
-            for &(c, amp) in &entries {
-                let slot = &mut amplitude[i as usize][c];
-                match slot {
-                    Some((prev, other)) if *prev != amp => {
-                        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
-                            key: format!("groups.{}", g.name),
-                            value: format!("particle {i} at {:?}", particles.x0[i as usize].as_slice()),
-                            allowed: format!(
-                                "groups that overlap must prescribe the same displacement: groups.{other} already prescribes {prev} m in component {c}, this group {amp} m"
-                            ),
-                        }))
-                    }
-                    _ => *slot = Some((amp, g.name.clone())),
-                }
-                constrained[i as usize][c] = true;
-            }
-        }
-        groups.push(groups::Group {
-            name: g.name.clone(),
-            members,
-        });
-    }
-    let prescribed: Vec<Prescribed> = (0..n)
-        .flat_map(|i| {
-            let a = amplitude[i].clone();
-            (0..2).filter_map(move |c| {
-                a[c].as_ref().map(|(amp, _)| Prescribed {
-                    particle: i as u32,
-                    component: c as u8,
-                    amplitude: *amp,
-                })
-            })
-        })
-        .collect();
+    let extent = format!(
+        "x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m",
+        body_lo.x, body_hi.x, body_lo.y, body_hi.y
+    );
+    let (groups, constrained, prescribed) = supports(
+        scene,
+        &particles,
+        &|sel| groups::select(sel, &particles, &shape),
+        &extent,
+    )?;
 
     // Micro-moduli, with the surface treatment of particles that miss bonds.
     stage("micro-moduli and the surface correction");
@@ -401,6 +357,73 @@ fn assemble<const K: usize>(
         fields,
         random,
     })
+}
+
+/// The scene's groups on a body, its supports (`constrained`) and its prescribed
+/// displacements; `select` picks a selection's members, `extent` describes the body for the
+/// message of a selection that picks nothing.
+#[allow(clippy::type_complexity)]
+pub(crate) fn supports<const D: usize, const K: usize>(
+    scene: &Scene,
+    particles: &Particles<D, K>,
+    select: &dyn Fn(&crate::scene::Selection) -> Vec<u32>,
+    extent: &str,
+) -> Result<(Vec<groups::Group>, Vec<[bool; D]>, Vec<Prescribed>), RunError> {
+    let n = particles.len();
+    let mut groups = Vec::new();
+    let mut constrained = vec![[false; D]; n];
+    let mut amplitude: Vec<[Option<(f64, String)>; D]> = vec![std::array::from_fn(|_| None); n];
+    for g in &scene.groups {
+        let members = select(&g.select);
+        if members.is_empty() {
+            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                key: format!("groups.{}.select", g.name),
+                value: g.select.scene_text(),
+                allowed: format!(
+                    "a selection that contains at least one particle; the body spans {extent}"
+                ),
+            }));
+        }
+        let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
+        if let Some(l) = &g.load {
+            entries.push((l.component.index(), l.delta()));
+        }
+        for &i in &members {
+            for &(c, amp) in &entries {
+                let slot = &mut amplitude[i as usize][c];
+                match slot {
+                    Some((prev, other)) if *prev != amp => {
+                        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                            key: format!("groups.{}", g.name),
+                            value: format!("particle {i} at {:?}", particles.x0[i as usize].as_slice()),
+                            allowed: format!(
+                                "groups that overlap must prescribe the same displacement: groups.{other} already prescribes {prev} m in component {c}, this group {amp} m"
+                            ),
+                        }))
+                    }
+                    _ => *slot = Some((amp, g.name.clone())),
+                }
+                constrained[i as usize][c] = true;
+            }
+        }
+        groups.push(groups::Group {
+            name: g.name.clone(),
+            members,
+        });
+    }
+    let prescribed: Vec<Prescribed> = (0..n)
+        .flat_map(|i| {
+            let a = amplitude[i].clone();
+            (0..D).filter_map(move |c| {
+                a[c].as_ref().map(|(amp, _)| Prescribed {
+                    particle: i as u32,
+                    component: c as u8,
+                    amplitude: *amp,
+                })
+            })
+        })
+        .collect();
+    Ok((groups, constrained, prescribed))
 }
 
 /// The boundary treatment of a lattice body (`discretisation.surface`, MODEL.md §1, §3) into
@@ -548,7 +571,10 @@ pub fn fit_moduli<const K: usize>(
 }
 
 /// A failed modal analysis, with the scene keys T1 depends on.
-fn modal_failure<const K: usize>(model: &Model<K>, e: modal::ModalError) -> RunError {
+fn modal_failure<const K: usize, const D: usize>(
+    model: &Model<K, D>,
+    e: modal::ModalError,
+) -> RunError {
     let text = e.to_string();
     if text.contains("every particle is constrained") {
         return RunError::Setup(format!("{text}: groups fix or load every component of every particle, so nothing is left to move; free some components (groups.*.fix, groups.*.load)"));
@@ -586,7 +612,16 @@ pub fn prepare_with<const K: usize>(
     scene: &Scene,
     stage: &dyn Fn(&str),
 ) -> Result<Prepared<K>, RunError> {
-    let mut model = prepare_model_with(scene, stage)?;
+    dynamics(prepare_model_with(scene, stage)?, stage)
+}
+
+/// T1, the dampers, the time step, the run's length and its probe of an assembled model (2D
+/// or 3D).
+pub(crate) fn dynamics<const K: usize, const D: usize>(
+    mut model: Model<K, D>,
+    stage: &dyn Fn(&str),
+) -> Result<Prepared<K, D>, RunError> {
+    let scene = &model.scene.clone();
     // A free particle with one bond has no stiffness across it: a zero-frequency mode that
     // Lanczos may or may not report (with clipped cells it found ω² ≈ 3e-5 rad²/s² and
     // T1 = 1e3 s for the spike of tests/proptest_scenes.rs); refuse it before.
@@ -595,9 +630,13 @@ pub fn prepare_with<const K: usize>(
         if p.bond_count(i) != 1 {
             return false;
         }
-        // the direction across its one bond is free of every held component
+        // 2D: the direction across its one bond is free of every held component; 3D: it
+        // swings unless every component is held
+        if D != 2 {
+            return model.constrained[i].iter().any(|&c| !c);
+        }
         let (n, _) = p.reference_bonds(i)[0];
-        let across = [-n.y, n.x];
+        let across = [-n[1], n[0]];
         (0..2).all(|c| !model.constrained[i][c] || across[c].abs() < 1e-9)
     };
     if (0..p.len()).any(swings) {

@@ -1,10 +1,13 @@
-//! The body of a 3D scene (`discretisation.lattice = "fcc"`, issue "3D"): the FCC lattice in
-//! the scene's solid, its boundary treatment and micro-moduli, and what `sppm check` reports
-//! of it. Groups, supports and the run itself on a 3D body are the next step of that issue:
-//! until they land, [`super::prepare`] refuses a 3D scene with a message that says so.
+//! The body and model of a 3D scene (`discretisation.lattice = "fcc"`, issue "3D"): the FCC
+//! lattice in the scene's solid, its boundary treatment and micro-moduli, its groups and
+//! supports ([`prepare_model_solid`]), then the same dynamics as 2D ([`prepare_solid`]).
+//! Elastic scenes run; `[concrete]` and random fields in 3D are refused until the concrete
+//! kernels carry the second-neighbour modulus c.
 
+use super::prepare::{dynamics, supports, Model, Prepared, SurfaceCorrection};
 use super::RunError;
 use crate::discretise::fcc::{assign_moduli, FccLattice, ModuliReport, SLOTS};
+use crate::discretise::groups;
 use crate::discretise::{bytes_per_particle, voronoi3, Particles};
 use crate::geometry::Shape3;
 use crate::limits::available_memory;
@@ -108,8 +111,8 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
     let e = m.youngs_modulus();
     let mut moduli = assign_moduli(&mut p, e, m.nu);
     if method == Surface::Lattice {
+        let bulk = crate::discretise::fcc::bulk_moduli(e, m.nu, d.spacing);
         for i in 0..p.len() {
-            let bulk = crate::model::micro_modulus::fcc(e, m.nu, p.length[i]);
             (p.a[i], p.b[i], p.c[i]) = (bulk.a, bulk.b, bulk.c);
         }
         moduli = ModuliReport {
@@ -124,4 +127,95 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
         moduli,
     };
     Ok((p, report))
+}
+
+/// The assembled elastic model of a 3D scene (FCC, 18 slots): body, groups, supports,
+/// micro-moduli.
+pub fn prepare_model_solid(
+    scene: &Scene,
+    stage: &dyn Fn(&str),
+) -> Result<Model<SLOTS, 3>, RunError> {
+    let refuse = |key: &str, value: String, allowed: &str| {
+        RunError::Scene(crate::scene::SceneError::Invalid {
+            key: key.into(),
+            value,
+            allowed: allowed.into(),
+        })
+    };
+    if scene.concrete.is_some() {
+        return Err(refuse(
+            "concrete",
+            "a [concrete] section".into(),
+            "absent in 3D for now: the 3D run is elastic until the concrete kernels carry the FCC second-neighbour modulus (issue \"3D\")",
+        ));
+    }
+    if !scene.random_field.is_empty() {
+        return Err(refuse(
+            "random_field",
+            format!("{} random fields", scene.random_field.len()),
+            "absent in 3D for now (the fields are sampled in the plane)",
+        ));
+    }
+    stage(&format!(
+        "filling the body with about {:.3e} FCC particles",
+        scene
+            .solid()
+            .map_or(0.0, |solid| estimated_particles(scene, &solid))
+    ));
+    let (particles, body) = fcc_body(scene)?;
+    let solid = scene.solid().expect("fcc_body checked the solid");
+    let section = match (&scene.body, &solid) {
+        (crate::scene::BodySpec::Prism { .. }, _) => Some(scene.shape()),
+        (_, Shape3::Cylinder { axis, .. }) if axis.x.abs() < 1e-12 && axis.y.abs() < 1e-12 => {
+            Some(scene.shape())
+        }
+        _ => None,
+    };
+    let (lo, hi) = solid.bounding_box();
+    let extent = format!(
+        "x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m, z ∈ [{:.6}, {:.6}] m",
+        lo.x, hi.x, lo.y, hi.y, lo.z, hi.z
+    );
+    let (groups, constrained, prescribed) = supports(
+        scene,
+        &particles,
+        &|sel| groups::select_3d(sel, &particles, &solid, section.as_ref()),
+        &extent,
+    )?;
+    let m = &scene.material;
+    let n = particles.len();
+    let bulk =
+        crate::discretise::fcc::bulk_moduli(m.youngs_modulus(), m.nu, scene.discretisation.spacing);
+    let mech = crate::solver::mechanics::Mechanics::new(&particles, &vec![m.rho; n]);
+    let moduli = body.moduli;
+    let surface = SurfaceCorrection {
+        method: body.method,
+        enabled: body.method != "lattice",
+        boundary_particles: n - moduli.bulk,
+        corrected: moduli.fitted + moduli.fitted_without_c,
+        kept_bulk: moduli.unfitted,
+        max_residual: moduli.max_residual,
+        body_volume: body.body_volume,
+        particle_volume: body.particle_volume,
+    };
+    Ok(Model {
+        scene: scene.clone(),
+        particles,
+        groups,
+        prescribed,
+        constrained,
+        mech,
+        bulk: crate::model::dimension::MicroModuli {
+            a: bulk.a,
+            b: bulk.b,
+        },
+        surface,
+        fields: Vec::new(),
+        random: None,
+    })
+}
+
+/// Discretise and assemble a 3D scene, compute T1 and the time step.
+pub fn prepare_solid(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Prepared<SLOTS, 3>, RunError> {
+    dynamics(prepare_model_solid(scene, stage)?, stage)
 }

@@ -114,6 +114,7 @@ pub struct RandomReport {
 /// 2D), stresses as 6 Voigt components [σxx, σyy, σzz, σyz, σxz, σxy] (in 2D the
 /// out-of-plane components are 0, as the 2D reports always showed them), so that `output`
 /// and `study` serve every dimension from one copy.
+#[derive(Clone)]
 pub struct Outcome {
     pub summary: Summary,
     /// Random particles: each particle's Voronoi cell clipped to the body (reference
@@ -134,6 +135,9 @@ pub struct Outcome {
     pub scene: Scene,
     /// The random fields' values at each particle (MODEL.md §12).
     pub fields: Vec<SampledField>,
+    /// The names of the maps' horizontal and vertical axes: "x", "y" in 2D; a section of a
+    /// 3D run (`output::section`) names its own.
+    pub axes: [&'static str; 2],
 }
 
 impl Outcome {
@@ -193,8 +197,8 @@ pub(super) struct Finished<'a> {
     pub failure: Option<String>,
 }
 
-pub(super) fn summarise<const K: usize>(
-    p: &Prepared<K>,
+pub(super) fn summarise<const K: usize, const D: usize>(
+    p: &Prepared<K, D>,
     run: &Finished,
     damage: Option<&[ParticleDamage]>,
 ) -> Summary {

@@ -603,6 +603,8 @@ pub struct GroupSpec {
 pub enum Axis {
     X,
     Y,
+    /// 3D only.
+    Z,
 }
 
 impl Axis {
@@ -610,6 +612,7 @@ impl Axis {
         match self {
             Axis::X => 0,
             Axis::Y => 1,
+            Axis::Z => 2,
         }
     }
 }
@@ -622,6 +625,10 @@ pub enum Edge {
     Top,
     Left,
     Right,
+    /// The face at the smallest z (3D only).
+    Front,
+    /// The face at the largest z (3D only).
+    Back,
 }
 
 /// How the particles of a group are chosen.
@@ -641,11 +648,12 @@ pub enum Selection {
         #[serde(default)]
         depth: Option<f64>,
     },
-    /// Particles inside an axis-aligned box.
-    Box { min: [f64; 2], max: [f64; 2] },
+    /// Particles inside an axis-aligned box (two corners of as many components as the
+    /// scene has dimensions).
+    Box { min: Vec<f64>, max: Vec<f64> },
     /// The one particle nearest a point (for a point support that must exist at every
     /// lattice rotation and offset).
-    Nearest { point: [f64; 2] },
+    Nearest { point: Vec<f64> },
     /// Every particle.
     All,
 }

@@ -198,6 +198,7 @@ impl Scene {
 
         let mut names = HashSet::new();
         let mut any_load = false;
+        let dim = self.discretisation.dim();
         for (gi, g) in self.groups.iter().enumerate() {
             let key = format!("groups[{gi}]");
             if g.name.is_empty() {
@@ -216,7 +217,14 @@ impl Scene {
             }
             let key = format!("groups.{}", g.name);
             match &g.select {
-                Selection::Edge { rows, .. } => {
+                Selection::Edge { edge, rows } => {
+                    if dim == 2 && matches!(edge, Edge::Front | Edge::Back) {
+                        return Err(invalid(
+                            format!("{key}.select.edge"),
+                            format!("{edge:?}").to_lowercase(),
+                            "bottom, top, left or right in 2D (front and back are the faces at the smallest and largest z of a 3D body)",
+                        ));
+                    }
                     if *rows == 0 || *rows > 20 {
                         return Err(invalid(
                             format!("{key}.select.rows"),
@@ -226,11 +234,18 @@ impl Scene {
                     }
                 }
                 Selection::Strip {
+                    edge,
                     width,
                     depth,
                     centre,
-                    ..
                 } => {
+                    if matches!(edge, Edge::Front | Edge::Back) {
+                        return Err(invalid(
+                            format!("{key}.select.edge"),
+                            format!("{edge:?}").to_lowercase(),
+                            "bottom, top, left or right: a strip runs along the body's section (in 3D along z, the generatrix of a cylinder or a prism)",
+                        ));
+                    }
                     positive(&format!("{key}.select.width"), *width)?;
                     finite(&format!("{key}.select.centre"), *centre)?;
                     if let Some(dp) = depth {
@@ -238,7 +253,16 @@ impl Scene {
                     }
                 }
                 Selection::Box { min, max } => {
-                    for c in 0..2 {
+                    for (corner, v) in [("min", min), ("max", max)] {
+                        if v.len() != dim {
+                            return Err(invalid(
+                                format!("{key}.select.{corner}"),
+                                format!("{v:?}"),
+                                format!("{dim} components (m), one per dimension of the scene"),
+                            ));
+                        }
+                    }
+                    for c in 0..dim {
                         finite(&format!("{key}.select.min[{c}]"), min[c])?;
                         finite(&format!("{key}.select.max[{c}]"), max[c])?;
                         if max[c] <= min[c] {
@@ -251,12 +275,34 @@ impl Scene {
                     }
                 }
                 Selection::Nearest { point } => {
-                    finite(&format!("{key}.select.point[0]"), point[0])?;
-                    finite(&format!("{key}.select.point[1]"), point[1])?;
+                    if point.len() != dim {
+                        return Err(invalid(
+                            format!("{key}.select.point"),
+                            format!("{point:?}"),
+                            format!("{dim} components (m), one per dimension of the scene"),
+                        ));
+                    }
+                    for (c, v) in point.iter().enumerate() {
+                        finite(&format!("{key}.select.point[{c}]"), *v)?;
+                    }
                 }
                 Selection::All => {}
             }
             let mut fixed = HashSet::new();
+            let axes = g
+                .fix
+                .iter()
+                .map(|a| (a, "fix"))
+                .chain(g.load.as_ref().map(|l| (&l.component, "load.component")));
+            for (a, what) in axes {
+                if a.index() >= dim {
+                    return Err(invalid(
+                        format!("{key}.{what}"),
+                        "\"z\"",
+                        "the axes \"x\" and \"y\" in 2D (\"z\" is for 3D scenes, lattice = \"fcc\")",
+                    ));
+                }
+            }
             for a in &g.fix {
                 if !fixed.insert(a.index()) {
                     return Err(invalid(
