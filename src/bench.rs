@@ -12,7 +12,7 @@
 use crate::discretise::csr::Csr;
 use crate::discretise::hex::HexLattice;
 use crate::discretise::random::{self, RandomParticles};
-use crate::discretise::{Particles, NONE};
+use crate::discretise::Particles;
 use crate::geometry::Shape2;
 use crate::model::micro_modulus;
 use crate::scene::Plane;
@@ -258,31 +258,6 @@ fn time_steps<const K: usize>(
     })
 }
 
-/// The 18 FCC bond offsets in half-cells (the cubic cell a = √2·L0 is 2 half-cells): the 12
-/// nearest neighbours (permutations of (±1, ±1, 0), at L0) in slots 0..12, then the 6 second
-/// neighbours ((±2, 0, 0) and permutations, at √2·L0) in slots 12..18; each direction's
-/// opposite is in the adjacent slot, so the reverse of slot k is k ^ 1.
-pub const FCC_OFFSETS: [[i64; 3]; 18] = [
-    [1, 1, 0],
-    [-1, -1, 0],
-    [1, -1, 0],
-    [-1, 1, 0],
-    [1, 0, 1],
-    [-1, 0, -1],
-    [1, 0, -1],
-    [-1, 0, 1],
-    [0, 1, 1],
-    [0, -1, -1],
-    [0, 1, -1],
-    [0, -1, 1],
-    [2, 0, 0],
-    [-2, 0, 0],
-    [0, 2, 0],
-    [0, -2, 0],
-    [0, 0, 2],
-    [0, 0, -2],
-];
-
 /// Cells per side of the FCC cube [`fcc_block`] whose particle count is nearest `particles`.
 pub fn fcc_cells(particles: usize) -> usize {
     let count = |n: usize| fcc_block_len(n) as f64;
@@ -308,52 +283,26 @@ pub const fn fcc_block_len(cells: usize) -> usize {
 
 /// A cube of FCC lattice with nearest spacing `l0` and `cells` cubic cells (a = √2·L0) per
 /// side, faces included: the points (i, j, k)·L0/√2 with i, j, k in 0..=2·cells and i+j+k
-/// even, in x-fastest order; slots as [`FCC_OFFSETS`] (empty beyond the faces); every
-/// particle the bulk volume (√2/2)·L0³ and the bulk moduli of E = 30 GPa, ν = 0.2
-/// ([`micro_modulus::fcc`]).
+/// even, in x-fastest order (`discretise::fcc::FccLattice` unrotated in a cube of side
+/// cells·a), with the weighted dilatation the lattice runs with; every particle the bulk
+/// volume (√2/2)·L0³ and the bulk moduli of E = 30 GPa, ν = 0.2
+/// (`discretise::fcc::bulk_moduli`).
 pub fn fcc_block(cells: usize, l0: f64) -> Particles<3, 18> {
-    let side = 2 * cells as i64 + 1;
-    let h = l0 / 2f64.sqrt();
-    let at = |i: i64, j: i64, k: i64| ((k * side + j) * side + i) as usize;
-    let mut index = vec![NONE; (side * side * side) as usize];
-    let mut x0 = Vec::with_capacity(fcc_block_len(cells));
-    let mut cell = Vec::with_capacity(fcc_block_len(cells));
-    for k in 0..side {
-        for j in 0..side {
-            for i in 0..side {
-                if (i + j + k) % 2 == 0 {
-                    index[at(i, j, k)] = x0.len() as u32;
-                    x0.push(Vector3::new(i as f64, j as f64, k as f64) * h);
-                    cell.push([i, j, k]);
-                }
-            }
-        }
+    use crate::discretise::fcc::FccLattice;
+    use crate::run::solid::bulk_moduli;
+    let side = cells as f64 * 2f64.sqrt() * l0;
+    let mut p = FccLattice {
+        spacing: l0,
+        rotation_deg: [0.0; 3],
+        offset: Vector3::zeros(),
     }
-    let n = x0.len();
-    let second = l0 * 2f64.sqrt();
-    let mut neighbours = vec![[NONE; 18]; n];
-    let mut reverse = vec![[0u8; 18]; n];
-    let mut lengths = vec![[0.0; 18]; n];
-    let inside = |c: i64| (0..side).contains(&c);
-    for (p, c) in cell.iter().enumerate() {
-        for (s, o) in FCC_OFFSETS.iter().enumerate() {
-            let q = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
-            if q.iter().all(|&v| inside(v)) {
-                neighbours[p][s] = index[at(q[0], q[1], q[2])];
-                reverse[p][s] = (s ^ 1) as u8;
-                lengths[p][s] = if s < 12 { l0 } else { second };
-            }
-        }
-    }
-    let mut p = Particles::new(
-        x0,
-        vec![micro_modulus::fcc_volume(l0); n],
-        neighbours,
-        reverse,
-        lengths,
-        l0,
-    );
-    let mm = micro_modulus::fcc(30e9, 0.2, l0);
+    .fill(&crate::geometry::Shape3::Box {
+        origin: Vector3::zeros(),
+        size: Vector3::repeat(side),
+    });
+    debug_assert_eq!(p.len(), fcc_block_len(cells));
+    let n = p.len();
+    let mm = bulk_moduli(30e9, 0.2, l0);
     p.a = vec![mm.a; n];
     p.b = vec![mm.b; n];
     p.c = vec![mm.c; n];

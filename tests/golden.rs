@@ -52,6 +52,14 @@ const GOLDEN: &[Golden] = &[
         steps: 5171,
         particles: 3576,
     },
+    // The 3D FCC elastic prism (issue 15), recorded with 2 threads, checked on 1.
+    Golden {
+        scene: "elastic_block_3d",
+        peak_force_n: 8167.084061843607,
+        dissipated_energy_j: -2.1739486838305566e-14,
+        steps: 48597,
+        particles: 11581,
+    },
     Golden {
         scene: "elastic_plate",
         peak_force_n: 15347.60499016855,
@@ -231,6 +239,11 @@ fn every_shipped_scene_has_a_golden_record() {
     shipped.sort();
     let golden: Vec<&str> = GOLDEN.iter().map(|g| g.scene).collect();
     assert_eq!(shipped, golden);
+}
+
+#[test]
+fn golden_elastic_block_3d_on_one_thread() {
+    check("elastic_block_3d", "1");
 }
 
 #[test]

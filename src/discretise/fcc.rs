@@ -2,18 +2,13 @@
 //! rotation (three angles) and offset, clipped to the body. Each particle has 18 slots: the
 //! 12 nearest neighbours at L0 (slots 0..12) and the 6 second neighbours at √2·L0 (slots
 //! 12..18, [`SECOND`]); the direction of slot k^1 is the opposite of slot k's, so the reverse
-//! of slot k is k^1. ΔV = (√2/2)·L0³ ([`fcc_volume`]).
+//! of slot k is k^1. ΔV = (√2/2)·L0³ ([`cell_volume`]).
 //!
 //! In the lattice's own frame the sites are (i, j, k)·L0/√2 with i + j + k even (a cube of
 //! side √2·L0 with a site at each corner and face centre).
 
 use super::{drop_isolated, Particles, NONE};
 use crate::geometry::Shape3;
-use crate::model::dimension::{Dim, Dimension};
-use crate::model::micro_modulus::{
-    fcc_volume, fit_fcc_weighted, fit_weighted_3d, FccBond, FccModuli,
-};
-use crate::scene::Plane;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Slots per FCC particle.
@@ -42,6 +37,12 @@ pub const STEPS: [[i64; 3]; SLOTS] = [
     [0, 0, 2],
     [0, 0, -2],
 ];
+
+/// Volume ΔV = (√2/2)·L0³ of a lattice cell (a rhombic dodecahedron) with nearest spacing
+/// L0.
+pub fn cell_volume(l0: f64) -> f64 {
+    0.5 * 2f64.sqrt() * l0 * l0 * l0
+}
 
 /// Parameters of an FCC lattice.
 #[derive(Clone, Copy, Debug)]
@@ -143,14 +144,17 @@ impl FccLattice {
         unbond_flat_particles(&x0, &mut neighbours, &reverse);
         let mut particles = Particles::new(
             x0,
-            vec![fcc_volume(self.spacing); n],
+            vec![cell_volume(self.spacing); n],
             neighbours,
             reverse,
             l0,
             self.spacing,
         );
-        // θ_i = Σ_m (L0,im/ℓ_i)·S_im: conservative with bonds of two lengths (docs/fcc.md)
+        // θ_i = Σ_m (L0,im/ℓ_i)·S_im: conservative with bonds of two lengths (docs/fcc.md);
+        // ℓ_i = L0 for every particle (the lattice's own length scale, also where a surface
+        // particle keeps only second neighbours), so the weights are the same in every row
         particles.weighted_dilatation = true;
+        particles.length = vec![self.spacing; particles.len()];
         drop_isolated(&mut particles);
         particles
     }
@@ -196,90 +200,6 @@ fn unbond_flat_particles(
         next.dedup();
         todo = next;
     }
-}
-
-/// How the micro-moduli of an FCC body were set ([`assign_moduli`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
-pub struct ModuliReport {
-    /// Particles with all 18 bonds: the bulk constants (4.8) with the erratum (× the volume
-    /// fraction of a clipped cell).
-    pub bulk: usize,
-    /// Particles with missing bonds fitted (a, b, c) against D (3.20).
-    pub fitted: usize,
-    /// Particles with missing bonds whose (a, b, c) fit failed, fitted (a, b) with c = 0.
-    pub fitted_without_c: usize,
-    /// Particles no fit could serve (too few or coplanar bonds), given the bulk constants
-    /// scaled by their volume fraction.
-    pub unfitted: usize,
-    /// Largest relative residual ‖D_i − D‖/‖D‖ of a fitted particle.
-    pub max_residual: f64,
-}
-
-/// The bulk constants (a, b, c) of an FCC particle with nearest spacing `l0` under the
-/// weighted dilatation the lattice runs with (MODEL.md §3 with its erratum; the closed forms
-/// (4.8) hold for the source's unweighted θ, see [`fit_fcc_weighted`]): the exact fit of the
-/// 18 bonds and the full cell to the isotropic D.
-pub fn bulk_moduli(e: f64, nu: f64, l0: f64) -> FccModuli {
-    let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
-    let bonds: Vec<FccBond> = STEPS
-        .iter()
-        .enumerate()
-        .map(|(k, s)| {
-            let v = Vector3::new(s[0] as f64, s[1] as f64, s[2] as f64);
-            (v.normalize(), v.norm() * l0 / 2f64.sqrt(), k >= SECOND)
-        })
-        .collect();
-    fit_fcc_weighted(&bonds, fcc_volume(l0), l0, &d)
-        .expect("the bulk FCC particle spans D")
-        .moduli
-}
-
-/// Set a, b, c of every particle of an FCC body for the isotropic (E, ν) (MODEL.md §3 with
-/// its erratum) and its volume `p.volume` (the full cell, or the cell clipped to the body,
-/// `voronoi3::fcc_clipped_volumes`), for the weighted dilatation θ_i = Σ_m (L0,im/ℓ_i)·S_im
-/// the lattice runs with ([`FccLattice::fill`] sets it): [`bulk_moduli`] scaled by the
-/// particle's volume fraction for a particle with all 18 bonds; for one with missing bonds
-/// the least-squares (a, b, c) of its own bonds and volume against D (3.20,
-/// [`fit_fcc_weighted`]), or (a, b) with c = 0 where that fit fails, or the bulk constants
-/// scaled by the volume fraction where no fit exists.
-pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliReport {
-    let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
-    let mut report = ModuliReport::default();
-    for i in 0..p.len() {
-        let ell = p.length[i];
-        let bulk = bulk_moduli(e, nu, p.spacing);
-        let fraction = p.volume[i] / fcc_volume(p.spacing);
-        let (mut a, mut b, mut c) = (bulk.a * fraction, bulk.b * fraction, bulk.c * fraction);
-        if p.bond_count(i) == SLOTS {
-            report.bulk += 1;
-        } else {
-            let bonds: Vec<FccBond> = (0..SLOTS)
-                .filter(|&k| p.neighbours[i][k] != NONE)
-                .map(|k| {
-                    let j = p.neighbours[i][k] as usize;
-                    ((p.x0[j] - p.x0[i]).normalize(), p.l0[i][k], k >= SECOND)
-                })
-                .collect();
-            if let Some(f) = fit_fcc_weighted(&bonds, p.volume[i], ell, &d) {
-                (a, b, c) = (f.moduli.a, f.moduli.b, f.moduli.c);
-                report.fitted += 1;
-                report.max_residual = report.max_residual.max(f.residual);
-            } else {
-                let plain: Vec<_> = bonds.iter().map(|&(n, l, _)| (n, l)).collect();
-                if let Some(f) = fit_weighted_3d(&plain, p.volume[i], ell, &d) {
-                    (a, b, c) = (f.moduli.a, f.moduli.b, 0.0);
-                    report.fitted_without_c += 1;
-                    report.max_residual = report.max_residual.max(f.residual);
-                } else {
-                    report.unfitted += 1;
-                }
-            }
-        }
-        p.a[i] = a;
-        p.b[i] = b;
-        p.c[i] = c;
-    }
-    report
 }
 
 #[cfg(test)]
@@ -356,7 +276,7 @@ mod tests {
                 };
                 let p = lat.fill(&cube(side));
                 p.check_topology().unwrap();
-                let ratio = p.len() as f64 * fcc_volume(l0) / side.powi(3);
+                let ratio = p.len() as f64 * cell_volume(l0) / side.powi(3);
                 // a surface layer of at most one plane spacing (≤ L0) on each face: ±6·L0/side
                 assert!(
                     (ratio - 1.0).abs() < 6.0 * l0 / side,

@@ -8,10 +8,9 @@
 //! which lies more than the cell's circumradius (L0/√2) inside the body keeps the full
 //! rhombic dodecahedron, (√2/2)·L0³, without clipping.
 
-use super::fcc::{SECOND, SLOTS};
+use super::fcc::{cell_volume, SECOND, SLOTS};
 use super::{Particles, NONE};
 use crate::geometry::Shape3;
-use crate::model::micro_modulus::fcc_volume;
 use nalgebra::Vector3;
 use rstar::{primitives::GeomWithData, RTree};
 
@@ -141,7 +140,7 @@ pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Option<Ve
     let pad = P::repeat(1e-3 * shape.size());
     let body = ConvexPolyhedron::from_planes(&planes, lo - pad, hi + pad);
     let l0 = p.spacing;
-    let full = fcc_volume(l0);
+    let full = cell_volume(l0);
     let inside = |x: &P| {
         planes
             .iter()
@@ -227,7 +226,7 @@ mod tests {
                 cell.clip(&d, d.dot(&(p.x0[c] + d * 0.5)));
             }
         }
-        assert_relative_eq!(cell.volume(), fcc_volume(l0), max_relative = 1e-12);
+        assert_relative_eq!(cell.volume(), cell_volume(l0), max_relative = 1e-12);
         assert_eq!(cell.faces.len(), 12);
     }
 
@@ -255,7 +254,7 @@ mod tests {
                 let v = fcc_clipped_volumes(&p, &shape).unwrap();
                 let total: f64 = v.iter().sum();
                 assert_relative_eq!(total, shape.volume(), max_relative = 1e-9);
-                assert!(v.iter().all(|&x| x > 0.0 && x <= fcc_volume(l0) * 2.5));
+                assert!(v.iter().all(|&x| x > 0.0 && x <= cell_volume(l0) * 2.5));
             }
         }
     }

@@ -77,19 +77,22 @@ pub struct Prepared<const K: usize = 6, const D: usize = 2> {
 /// Particles the body will hold (area / cell area; in 3D volume / cell volume), known
 /// before anything is allocated.
 pub fn estimated_particles(scene: &Scene) -> f64 {
-    if let Some(solid) = scene.solid() {
-        return super::solid::estimated_particles(scene, &solid);
-    }
     let l0 = scene.discretisation.spacing;
+    if let Some(solid) = scene.solid() {
+        return solid.volume() / crate::discretise::fcc::cell_volume(l0);
+    }
     scene.shape().area() / (0.5 * 3f64.sqrt() * l0 * l0)
 }
 
-/// Estimated bytes a run allocates.
+/// Estimated bytes a run allocates (2D or 3D).
 pub fn estimated_memory(scene: &Scene) -> f64 {
-    if let Some(solid) = scene.solid() {
-        return super::solid::estimated_memory(scene, &solid);
-    }
-    estimated_particles(scene) * bytes_per_particle(2, slots_of(scene)) as f64
+    let dim = scene.discretisation.dim();
+    let slots = if dim == 3 {
+        crate::discretise::fcc::SLOTS
+    } else {
+        slots_of(scene)
+    };
+    estimated_particles(scene) * bytes_per_particle(dim, slots) as f64
 }
 
 /// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step), in

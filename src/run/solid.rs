@@ -4,14 +4,19 @@
 //! Elastic scenes run; `[concrete]` and random fields in 3D are refused until the concrete
 //! kernels carry the second-neighbour modulus c.
 
-use super::prepare::{dynamics, supports, Model, Prepared, SurfaceCorrection};
+use super::prepare::{
+    dynamics, estimated_memory, estimated_particles, supports, Model, Prepared, SurfaceCorrection,
+};
 use super::RunError;
-use crate::discretise::fcc::{assign_moduli, FccLattice, ModuliReport, SLOTS};
+use crate::discretise::fcc::{cell_volume, FccLattice, SECOND, SLOTS, STEPS};
 use crate::discretise::groups;
+use crate::discretise::NONE;
 use crate::discretise::{bytes_per_particle, voronoi3, Particles};
 use crate::geometry::Shape3;
 use crate::limits::available_memory;
-use crate::model::micro_modulus::fcc_volume;
+use crate::model::dimension::{Dim, Dimension};
+use crate::model::micro_modulus::{fit_fcc_weighted, fit_weighted_3d, FccBond, FccModuli};
+use crate::scene::Plane;
 use crate::scene::{Scene, Surface};
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -28,17 +33,6 @@ pub struct SolidBody {
     pub moduli: ModuliReport,
 }
 
-/// Particles an FCC body of the scene holds (volume / cell volume), before anything is
-/// allocated.
-pub fn estimated_particles(scene: &Scene, solid: &Shape3) -> f64 {
-    solid.volume() / fcc_volume(scene.discretisation.spacing)
-}
-
-/// Estimated bytes a 3D run allocates.
-pub fn estimated_memory(scene: &Scene, solid: &Shape3) -> f64 {
-    estimated_particles(scene, solid) * bytes_per_particle(3, SLOTS) as f64
-}
-
 /// The FCC body of a 3D scene with its volumes and micro-moduli. `discretisation.surface`:
 /// "voronoi_fit" (the default) clips each cell to the body (`discretise::voronoi3`) where
 /// the body is a convex polyhedron (a box) and fits the boundary particles' (a, b, c); on a
@@ -52,24 +46,24 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
             "discretisation.lattice = \"fcc\" needs a solid body (box, cylinder or prism)".into(),
         )
     })?;
-    let need = estimated_memory(scene, &solid);
+    let need = estimated_memory(scene);
     if let Some(avail) = available_memory() {
         if need > 0.8 * avail as f64 {
             return Err(RunError::Setup(format!(
                 "discretisation.spacing = {}: the FCC body would hold about {:.3e} particles needing about {:.1} GiB at {} bytes each, more than this machine has available ({:.1} GiB); use a larger spacing",
                 d.spacing,
-                estimated_particles(scene, &solid),
+                estimated_particles(scene),
                 need / 2f64.powi(30),
                 bytes_per_particle(3, SLOTS),
                 avail as f64 / 2f64.powi(30)
             )));
         }
     }
-    if estimated_particles(scene, &solid) > u32::MAX as f64 / 2.0 {
+    if estimated_particles(scene) > u32::MAX as f64 / 2.0 {
         return Err(RunError::Setup(format!(
             "discretisation.spacing = {}: about {:.3e} particles, more than the 2.1e9 a run can index",
             d.spacing,
-            estimated_particles(scene, &solid)
+            estimated_particles(scene)
         )));
     }
     let method = d.surface();
@@ -111,7 +105,7 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
     let e = m.youngs_modulus();
     let mut moduli = assign_moduli(&mut p, e, m.nu);
     if method == Surface::Lattice {
-        let bulk = crate::discretise::fcc::bulk_moduli(e, m.nu, d.spacing);
+        let bulk = bulk_moduli(e, m.nu, d.spacing);
         for i in 0..p.len() {
             (p.a[i], p.b[i], p.c[i]) = (bulk.a, bulk.b, bulk.c);
         }
@@ -158,12 +152,14 @@ pub fn prepare_model_solid(
     }
     stage(&format!(
         "filling the body with about {:.3e} FCC particles",
-        scene
-            .solid()
-            .map_or(0.0, |solid| estimated_particles(scene, &solid))
+        estimated_particles(scene)
     ));
     let (particles, body) = fcc_body(scene)?;
-    let solid = scene.solid().expect("fcc_body checked the solid");
+    let solid = scene.solid().ok_or_else(|| {
+        RunError::Setup(
+            "discretisation.lattice = \"fcc\" needs a solid body (box, cylinder or prism)".into(),
+        )
+    })?;
     let section = match (&scene.body, &solid) {
         (crate::scene::BodySpec::Prism { .. }, _) => Some(scene.shape()),
         (_, Shape3::Cylinder { axis, .. }) if axis.x.abs() < 1e-12 && axis.y.abs() < 1e-12 => {
@@ -184,8 +180,7 @@ pub fn prepare_model_solid(
     )?;
     let m = &scene.material;
     let n = particles.len();
-    let bulk =
-        crate::discretise::fcc::bulk_moduli(m.youngs_modulus(), m.nu, scene.discretisation.spacing);
+    let bulk = bulk_moduli(m.youngs_modulus(), m.nu, scene.discretisation.spacing);
     let mech = crate::solver::mechanics::Mechanics::new(&particles, &vec![m.rho; n]);
     let moduli = body.moduli;
     let surface = SurfaceCorrection {
@@ -218,4 +213,88 @@ pub fn prepare_model_solid(
 /// Discretise and assemble a 3D scene, compute T1 and the time step.
 pub fn prepare_solid(scene: &Scene, stage: &dyn Fn(&str)) -> Result<Prepared<SLOTS, 3>, RunError> {
     dynamics(prepare_model_solid(scene, stage)?, stage)
+}
+
+/// How the micro-moduli of an FCC body were set ([`assign_moduli`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ModuliReport {
+    /// Particles with all 18 bonds: the bulk constants (4.8) with the erratum (× the volume
+    /// fraction of a clipped cell).
+    pub bulk: usize,
+    /// Particles with missing bonds fitted (a, b, c) against D (3.20).
+    pub fitted: usize,
+    /// Particles with missing bonds whose (a, b, c) fit failed, fitted (a, b) with c = 0.
+    pub fitted_without_c: usize,
+    /// Particles no fit could serve (too few or coplanar bonds), given the bulk constants
+    /// scaled by their volume fraction.
+    pub unfitted: usize,
+    /// Largest relative residual ‖D_i − D‖/‖D‖ of a fitted particle.
+    pub max_residual: f64,
+}
+
+/// The bulk constants (a, b, c) of an FCC particle with nearest spacing `l0` under the
+/// weighted dilatation the lattice runs with (MODEL.md §3 with its erratum; the closed forms
+/// (4.8) hold for the source's unweighted θ, see [`fit_fcc_weighted`]): the exact fit of the
+/// 18 bonds and the full cell to the isotropic D.
+pub fn bulk_moduli(e: f64, nu: f64, l0: f64) -> FccModuli {
+    let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
+    let bonds: Vec<FccBond> = STEPS
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let v = Vector3::new(s[0] as f64, s[1] as f64, s[2] as f64);
+            (v.normalize(), v.norm() * l0 / 2f64.sqrt(), k >= SECOND)
+        })
+        .collect();
+    fit_fcc_weighted(&bonds, cell_volume(l0), l0, &d)
+        .expect("the bulk FCC particle spans D")
+        .moduli
+}
+
+/// Set a, b, c of every particle of an FCC body for the isotropic (E, ν) (MODEL.md §3 with
+/// its erratum) and its volume `p.volume` (the full cell, or the cell clipped to the body,
+/// `voronoi3::fcc_clipped_volumes`), for the weighted dilatation θ_i = Σ_m (L0,im/ℓ_i)·S_im
+/// the lattice runs with ([`FccLattice::fill`](crate::discretise::fcc::FccLattice::fill) sets it): [`bulk_moduli`] scaled by the
+/// particle's volume fraction for a particle with all 18 bonds; for one with missing bonds
+/// the least-squares (a, b, c) of its own bonds and volume against D (3.20,
+/// [`fit_fcc_weighted`]), or (a, b) with c = 0 where that fit fails, or the bulk constants
+/// scaled by the volume fraction where no fit exists.
+pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliReport {
+    let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
+    let mut report = ModuliReport::default();
+    for i in 0..p.len() {
+        let ell = p.length[i];
+        let bulk = bulk_moduli(e, nu, p.spacing);
+        let fraction = p.volume[i] / cell_volume(p.spacing);
+        let (mut a, mut b, mut c) = (bulk.a * fraction, bulk.b * fraction, bulk.c * fraction);
+        if p.bond_count(i) == SLOTS {
+            report.bulk += 1;
+        } else {
+            let bonds: Vec<FccBond> = (0..SLOTS)
+                .filter(|&k| p.neighbours[i][k] != NONE)
+                .map(|k| {
+                    let j = p.neighbours[i][k] as usize;
+                    ((p.x0[j] - p.x0[i]).normalize(), p.l0[i][k], k >= SECOND)
+                })
+                .collect();
+            if let Some(f) = fit_fcc_weighted(&bonds, p.volume[i], ell, &d) {
+                (a, b, c) = (f.moduli.a, f.moduli.b, f.moduli.c);
+                report.fitted += 1;
+                report.max_residual = report.max_residual.max(f.residual);
+            } else {
+                let plain: Vec<_> = bonds.iter().map(|&(n, l, _)| (n, l)).collect();
+                if let Some(f) = fit_weighted_3d(&plain, p.volume[i], ell, &d) {
+                    (a, b, c) = (f.moduli.a, f.moduli.b, 0.0);
+                    report.fitted_without_c += 1;
+                    report.max_residual = report.max_residual.max(f.residual);
+                } else {
+                    report.unfitted += 1;
+                }
+            }
+        }
+        p.a[i] = a;
+        p.b[i] = b;
+        p.c[i] = c;
+    }
+    report
 }

@@ -715,6 +715,7 @@ mod tests {
             c_in,
             c_ex,
             dilatation_weight: None,
+            slot_weight: None,
             slot_end: filled(0, n),
         };
         let mut st = State::at_rest(&x0);

@@ -798,8 +798,10 @@ pub(crate) mod avx {
                 _mm256_storeu_pd(cache.add(2 * LANES * k + LANES), rinv);
             }
             // weighted dilatation (random particles): w·S, as the scalar path
-            let term = match (WEIGHTED, &m.dilatation_weight) {
-                (true, Some(w)) => {
+            let term = match (WEIGHTED, &m.slot_weight, &m.dilatation_weight) {
+                // the same weight in every row (the FCC lattice): broadcast it
+                (true, Some(u), _) => _mm256_mul_pd(_mm256_set1_pd(*u.get_unchecked(k)), st),
+                (true, None, Some(w)) => {
                     let wk = |l: usize| *w.get_unchecked(i0 + l).get_unchecked(k);
                     _mm256_mul_pd(_mm256_set_pd(wk(3), wk(2), wk(1), wk(0)), st)
                 }
@@ -1170,6 +1172,7 @@ mod tests {
             c_in,
             c_ex,
             dilatation_weight: None,
+            slot_weight: None,
             slot_end,
         };
         let mut st = State::at_rest(&x0);

@@ -42,6 +42,12 @@ pub struct Mechanics<const D: usize, const K: usize> {
     /// Per-slot weight L0,ik/ℓ_i of the dilatation θ_i = Σ_k w_ik·S_ik where the body asks
     /// for it (random particles, [`Particles::weighted_dilatation`]); `None`: θ_i = Σ_k S_ik.
     pub dilatation_weight: Option<Aligned<[f64; K]>>,
+    /// The weights of [`Self::dilatation_weight`] per slot where every particle with that
+    /// slot occupied has the same bits there (the FCC lattice: 1 for nearest, √2 for second
+    /// neighbours); `None` otherwise (random particles) or without weights. The AVX blocks
+    /// broadcast it instead of gathering slot k's weight from four rows: 8·K bytes less a
+    /// particle-step (benchmarks/RESULTS.md, "FCC"). Derived by [`uniform_inv_l0`]'s rule.
+    pub slot_weight: Option<[f64; K]>,
     /// One past each particle's last occupied slot: the AVX blocks stop at the largest of
     /// their four (random particles fill 6–11 of 12 slots).
     pub slot_end: Aligned<u8>,
@@ -62,6 +68,7 @@ impl<const D: usize, const K: usize> Default for Mechanics<D, K> {
             c_in: Aligned::new(0),
             c_ex: Aligned::new(0),
             dilatation_weight: None,
+            slot_weight: None,
             slot_end: Aligned::new(0),
         }
     }
@@ -181,9 +188,13 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
                 })
                 .collect_aligned()
         });
+        let slot_weight = dilatation_weight
+            .as_ref()
+            .and_then(|w| uniform_inv_l0(&p.neighbours, w));
         Mechanics {
             neighbours: copied(&p.neighbours),
             slot_inv_l0: uniform_inv_l0(&p.neighbours, &inv_l0),
+            slot_weight,
             inv_l0,
             a: copied(&p.a),
             b: copied(&p.b),

@@ -221,9 +221,8 @@ pub fn fcc_block_modulus(
     lattice: &crate::discretise::fcc::FccLattice,
     surface: &str,
 ) -> Result<(f64, f64), RunError> {
-    use crate::discretise::fcc::assign_moduli;
     use crate::geometry::Shape3;
-    use crate::model::micro_modulus::fcc;
+    use crate::run::solid::{assign_moduli, bulk_moduli};
     use crate::solver::mechanics::Mechanics;
     use nalgebra::{SMatrix, SVector};
     let shape = Shape3::Box {
@@ -238,7 +237,7 @@ pub fn fcc_block_modulus(
     }
     assign_moduli(&mut p, E, NU);
     if surface == "lattice" {
-        let m = fcc(E, NU, lattice.spacing);
+        let m = bulk_moduli(E, NU, lattice.spacing);
         (p.a, p.b, p.c) = (vec![m.a; n], vec![m.b; n], vec![m.c; n]);
     }
     let mech = Mechanics::new(&p, &vec![2400.0; n]);
