@@ -86,7 +86,12 @@ fn unknown_keys_and_wrong_types_are_named() {
         &error_of(&["groups.top.select.by=circle"]),
         &["circle", "edge"],
     );
-    says(&error_of(&["groups.bottom.fix=[\"z\"]"]), &["z", "`x`"]);
+    // z is an axis of 3D scenes only
+    says(
+        &error_of(&["groups.bottom.fix=[\"z\"]"]),
+        &["groups.bottom.fix", "z", "2D", "fcc"],
+    );
+    says(&error_of(&["groups.bottom.fix=[\"w\"]"]), &["w", "`x`"]);
     says(
         &error_of(&["loading.ramp=linear"]),
         &["linear", "cosine", "smoothstep"],
@@ -106,8 +111,13 @@ fn impossible_values_name_key_value_and_what_is_allowed() {
     let cases: &[(&[&str], &[&str])] = &[
         (&["name=\"a/b\""], &["name", "a/b", "path separators"]),
         (
+            &["discretisation.lattice=cubic"],
+            &["discretisation.lattice", "cubic", "hexagonal", "fcc"],
+        ),
+        // the FCC lattice fills solids: a 2D shape is told how to become one
+        (
             &["discretisation.lattice=fcc"],
-            &["discretisation.lattice", "fcc", "hexagonal"],
+            &["body.shape", "rectangle", "fcc", "prism"],
         ),
         (
             &["discretisation.spacing=0.0"],

@@ -39,6 +39,38 @@ fn every_shipped_body_carries_its_mass_at_any_rotation_and_offset() {
             continue;
         }
         let l0 = base.discretisation.spacing;
+        if base.discretisation.dim() == 3 {
+            // a 3D body (FCC): three angles, three offsets
+            for rot in [
+                [0.0, 0.0, 0.0],
+                [15.0, 0.0, 0.0],
+                [30.0, 20.0, 10.0],
+                [45.0, 35.26, 0.0],
+            ] {
+                for off in OFFSETS {
+                    let sets = [
+                        format!("discretisation.rotation_deg={rot:?}"),
+                        format!(
+                            "discretisation.offset=[{}, {}, {}]",
+                            off[0] * l0,
+                            off[1] * l0,
+                            0.5 * off[0] * l0
+                        ),
+                    ];
+                    let scene = Scene::from_toml_str(&text, &sets).unwrap();
+                    let model = sppm::run::solid::prepare_model_solid(&scene, &|_| {}).unwrap();
+                    let want = scene.material.rho * scene.solid().unwrap().volume();
+                    let got: f64 = model.mech.mass.iter().sum();
+                    assert!(
+                        (got / want - 1.0).abs() < 1e-9,
+                        "{}: rotation {rot:?}, offset {off:?}: mass {got} against {want}",
+                        path.display()
+                    );
+                    checked += 1;
+                }
+            }
+            continue;
+        }
         for rot in [0.0, 15.0, 30.0, 45.0] {
             for off in OFFSETS {
                 let sets = [
