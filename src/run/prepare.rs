@@ -95,6 +95,32 @@ pub fn estimated_memory(scene: &Scene) -> f64 {
     estimated_particles(scene) * bytes_per_particle(dim, slots) as f64
 }
 
+/// Refuse a scene whose body would not fit this machine's memory (80% of what is available)
+/// or that has more particles than a run can index, before anything is allocated.
+pub(crate) fn check_size(scene: &Scene) -> Result<(), RunError> {
+    let d = &scene.discretisation;
+    let need = estimated_memory(scene);
+    if let Some(avail) = available_memory() {
+        if need > 0.8 * avail as f64 {
+            return Err(RunError::Setup(format!(
+                "discretisation.spacing = {}: the body would hold about {:.3e} particles needing about {:.1} GiB, more than this machine has available ({:.1} GiB); use a larger spacing",
+                d.spacing,
+                estimated_particles(scene),
+                need / 2f64.powi(30),
+                avail as f64 / 2f64.powi(30)
+            )));
+        }
+    }
+    if estimated_particles(scene) > u32::MAX as f64 / 2.0 {
+        return Err(RunError::Setup(format!(
+            "discretisation.spacing = {}: about {:.3e} particles, more than the 2.1e9 a run can index",
+            d.spacing,
+            estimated_particles(scene)
+        )));
+    }
+    Ok(())
+}
+
 /// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step), in
 /// `K` bond slots (6: the hexagonal lattice; [`random::SLOTS_2D`]: random particles).
 pub struct Model<const K: usize = 6, const D: usize = 2> {
@@ -204,25 +230,7 @@ fn assemble<const K: usize>(
             scene.body.name()
         )));
     }
-    let need = estimated_memory(scene);
-    if let Some(avail) = available_memory() {
-        if need > 0.8 * avail as f64 {
-            return Err(RunError::Setup(format!(
-                "discretisation.spacing = {}: the body would hold about {:.3e} particles needing about {:.1} GiB, more than this machine has available ({:.1} GiB); use a larger spacing",
-                d.spacing,
-                estimated_particles(scene),
-                need / 2f64.powi(30),
-                avail as f64 / 2f64.powi(30)
-            )));
-        }
-    }
-    if estimated_particles(scene) > u32::MAX as f64 / 2.0 {
-        return Err(RunError::Setup(format!(
-            "discretisation.spacing = {}: about {:.3e} particles, more than the 2.1e9 a run can index",
-            d.spacing,
-            estimated_particles(scene)
-        )));
-    }
+    check_size(scene)?;
     let shape = scene.shape();
     stage(&format!(
         "filling the body with about {:.3e} particles",

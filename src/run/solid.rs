@@ -5,15 +5,14 @@
 //! kernels carry the second-neighbour modulus c.
 
 use super::prepare::{
-    dynamics, estimated_memory, estimated_particles, supports, Model, Prepared, SurfaceCorrection,
+    check_size, dynamics, estimated_particles, supports, Model, Prepared, SurfaceCorrection,
 };
 use super::RunError;
 use crate::discretise::fcc::{cell_volume, FccLattice, SECOND, SLOTS, STEPS};
 use crate::discretise::groups;
 use crate::discretise::NONE;
-use crate::discretise::{bytes_per_particle, voronoi3, Particles};
+use crate::discretise::{voronoi3, Particles};
 use crate::geometry::Shape3;
-use crate::limits::available_memory;
 use crate::model::dimension::{Dim, Dimension};
 use crate::model::micro_modulus::{fit_fcc_weighted, fit_weighted_3d, FccBond, FccModuli};
 use crate::scene::Plane;
@@ -46,26 +45,7 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
             "discretisation.lattice = \"fcc\" needs a solid body (box, cylinder or prism)".into(),
         )
     })?;
-    let need = estimated_memory(scene);
-    if let Some(avail) = available_memory() {
-        if need > 0.8 * avail as f64 {
-            return Err(RunError::Setup(format!(
-                "discretisation.spacing = {}: the FCC body would hold about {:.3e} particles needing about {:.1} GiB at {} bytes each, more than this machine has available ({:.1} GiB); use a larger spacing",
-                d.spacing,
-                estimated_particles(scene),
-                need / 2f64.powi(30),
-                bytes_per_particle(3, SLOTS),
-                avail as f64 / 2f64.powi(30)
-            )));
-        }
-    }
-    if estimated_particles(scene) > u32::MAX as f64 / 2.0 {
-        return Err(RunError::Setup(format!(
-            "discretisation.spacing = {}: about {:.3e} particles, more than the 2.1e9 a run can index",
-            d.spacing,
-            estimated_particles(scene)
-        )));
-    }
+    check_size(scene)?;
     let method = d.surface();
     let clipped = match method {
         Surface::VoronoiFit => true,

@@ -38,8 +38,14 @@ use crate::model::stretch::total_stretch;
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 
 /// Each particle's least-squares strain of its total bond stretches at positions x (the
-/// elastic model: no damage, no plastic stretch).
-pub fn elastic_strain<const K: usize>(model: &Model<K>, x: &[Vector2<f64>]) -> Vec<Matrix2<f64>> {
+/// elastic model: no damage, no plastic stretch), in 2D or 3D.
+pub fn elastic_strain<const K: usize, const D: usize>(
+    model: &Model<K, D>,
+    x: &[SVector<f64, D>],
+) -> Vec<SMatrix<f64, D, D>>
+where
+    Dim<D>: Dimension<D>,
+{
     let p = &model.particles;
     (0..p.len())
         .map(|i| {
@@ -54,7 +60,7 @@ pub fn elastic_strain<const K: usize>(model: &Model<K>, x: &[Vector2<f64>]) -> V
                 dirs[k] = Some((p.x0[j] - p.x0[i]).normalize());
                 s[k] = total_stretch((x[j] - x[i]).norm(), 1.0 / p.l0[i][k]);
             }
-            Dim::<2>::strain_tensor(&Dim::<2>::strain_fit(&dirs), &s)
+            Dim::<D>::strain_tensor(&Dim::<D>::strain_fit(&dirs), &s)
         })
         .collect()
 }
@@ -158,31 +164,17 @@ pub fn elastic_stress<const K: usize>(model: &Model<K>, x: &[Vector2<f64>]) -> V
 }
 
 /// The stress D·ε_i of each particle of a 3D model at positions x, ε_i the least-squares
-/// strain of its own total bond stretches (MODEL.md §7, §13): exact in the bulk of the FCC
-/// lattice under a homogeneous strain. The surface recovery of 2D (the affine patch fit) is
-/// not carried to 3D yet.
+/// strain of its own total bond stretches ([`elastic_strain`]; MODEL.md §7, §13): exact in
+/// the bulk of the FCC lattice under a homogeneous strain. The surface recovery of 2D (the
+/// affine patch fit) is not carried to 3D yet.
 pub fn own_stress_3d<const K: usize>(
     model: &Model<K, 3>,
     x: &[nalgebra::Vector3<f64>],
 ) -> Vec<nalgebra::Matrix3<f64>> {
-    let p = &model.particles;
     let m = &model.scene.material;
     let d = <Dim<3> as Dimension<3>>::elasticity(m.youngs_modulus(), m.nu, m.plane());
-    (0..p.len())
-        .map(|i| {
-            let mut dirs = [None; K];
-            let mut s = [0.0; K];
-            for k in 0..K {
-                let j = p.neighbours[i][k];
-                if j == NONE {
-                    continue;
-                }
-                let j = j as usize;
-                dirs[k] = Some((p.x0[j] - p.x0[i]).normalize());
-                s[k] = total_stretch((x[j] - x[i]).norm(), 1.0 / p.l0[i][k]);
-            }
-            let e = Dim::<3>::strain_tensor(&Dim::<3>::strain_fit(&dirs), &s);
-            Dim::<3>::stress_of_strain(&d, &e)
-        })
+    elastic_strain(model, x)
+        .iter()
+        .map(|e| Dim::<3>::stress_of_strain(&d, e))
         .collect()
 }
