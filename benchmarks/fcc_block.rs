@@ -6,16 +6,17 @@
 
 use nalgebra::Vector3;
 use sppm::discretise::fcc::FccLattice;
+use sppm::scene::Surface;
 use sppm::study::elastic_checks::fcc_block_modulus;
 
-const METHODS: [&str; 3] = ["voronoi_fit", "lattice_fit", "lattice"];
+const METHODS: [Surface; 3] = [Surface::VoronoiFit, Surface::LatticeFit, Surface::Lattice];
 
 fn main() {
     let l0 = 0.001;
     println!("# FCC block W × W × 2W, uniaxial tension: E/E0 − 1, ν/ν0 − 1 (%)");
     println!(
         "| W/L0 | rotation [α, β, γ] | offset/L0 | {} |",
-        METHODS.join(" | ")
+        METHODS.map(Surface::name).join(" | ")
     );
     println!("|---|---|---|{}", "---|".repeat(METHODS.len()));
     for w in [10.0, 20.0] {

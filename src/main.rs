@@ -180,11 +180,14 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 }
             };
             if sc.discretisation.dim() == 3 {
-                check_solid(&sc, mem, &stage)?;
+                let p = sppm::run::solid::prepare_solid(&sc, &stage)?;
+                check(&sc, mem, &stage, p, &sppm::run::execute::simulation_of)?;
             } else if sppm::run::prepare::slots_of(&sc) == sppm::discretise::random::SLOTS_2D {
-                check::<{ sppm::discretise::random::SLOTS_2D }>(&sc, mem, &stage)?;
+                let p = prepare_with::<{ sppm::discretise::random::SLOTS_2D }>(&sc, &stage)?;
+                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
             } else {
-                check::<6>(&sc, mem, &stage)?;
+                let p = prepare_with::<6>(&sc, &stage)?;
+                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -259,64 +262,20 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// `sppm check` of a 3D scene: the FCC body, its memory, its boundary treatment, T1 and the
-/// time step, and the run time from a few timed steps.
-fn check_solid(sc: &Scene, mem: f64, stage: &dyn Fn(&str)) -> anyhow::Result<()> {
-    let mut p = sppm::run::solid::prepare_solid(sc, stage)?;
-    stage("timing a few steps of the kernel");
-    let mut sim = sppm::run::execute::simulation_of(&mut p);
-    let calib = 20.min(p.steps.max(1));
-    let t = std::time::Instant::now();
-    for _ in 0..calib {
-        sim.advance(None);
-    }
-    let per_step = t.elapsed().as_secs_f64() / calib as f64;
-    say!("scene            {}", sc.name());
-    say!(
-        "lattice          fcc (3D), rotation {:?}°",
-        sc.discretisation.rotation_deg.angles()
-    );
-    say!("particles        {}", p.model.particles.len());
-    say!("bonds            {}", p.model.particles.bonds());
-    say!(
-        "groups           {}",
-        p.model
-            .groups
-            .iter()
-            .map(|g| format!("{} ({})", g.name, g.members.len()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    say!("fundamental T1   {:.6e} s", p.fundamental.period);
-    say!("stable dt        {:.6e} s", p.stable.dt_stable);
-    say!("time step dt     {:.6e} s", p.dt);
-    say!("t_end            {:.6e} s", p.t_end);
-    say!("steps            {}", p.steps);
-    say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-    say!(
-        "run time (est.)  {:.1} s on {} threads",
-        per_step * p.steps as f64,
-        rayon::current_num_threads()
-    );
-    let sf = &p.model.surface;
-    say!(
-        "surface          {}: {} boundary particles, {} fitted; largest residual {:.4}; particles' volume {:+.2e} of the body's",
-        sf.method,
-        sf.boundary_particles,
-        sf.corrected,
-        sf.max_residual,
-        sf.particle_volume / sf.body_volume - 1.0
-    );
-    Ok(())
-}
-
-/// `sppm check` of a scene whose body runs in K bond slots.
-fn check<const K: usize>(sc: &Scene, mem: f64, stage: &dyn Fn(&str)) -> anyhow::Result<()> {
-    let mut p = prepare_with::<K>(sc, stage)?;
+/// `sppm check` of a prepared scene (2D, or 3D with an FCC body), its simulation built by
+/// `simulate`: the body, groups, T1, time step, memory and the run time from a few timed
+/// steps.
+fn check<const K: usize, const D: usize>(
+    sc: &Scene,
+    mem: f64,
+    stage: &dyn Fn(&str),
+    mut p: sppm::run::Prepared<K, D>,
+    simulate: &dyn Fn(&mut sppm::run::Prepared<K, D>) -> sppm::solver::Simulation<D, K>,
+) -> anyhow::Result<()> {
     stage("timing a few steps of the kernel");
     // calibrate the run time with a few steps of the real kernel (with damage and
     // plasticity where the scene has them)
-    let mut sim = sppm::run::build_simulation(&mut p);
+    let mut sim = simulate(&mut p);
     let calib = 20.min(p.steps.max(1));
     let t = std::time::Instant::now();
     for _ in 0..calib {
@@ -324,6 +283,12 @@ fn check<const K: usize>(sc: &Scene, mem: f64, stage: &dyn Fn(&str)) -> anyhow::
     }
     let per_step = t.elapsed().as_secs_f64() / calib as f64;
     say!("scene            {}", sc.name());
+    if D == 3 {
+        say!(
+            "lattice          fcc (3D), rotation {:?}°",
+            sc.discretisation.rotation_deg.angles()
+        );
+    }
     say!("particles        {}", p.model.particles.len());
     say!("bonds            {}", p.model.particles.bonds());
     say!(
@@ -363,10 +328,11 @@ fn check<const K: usize>(sc: &Scene, mem: f64, stage: &dyn Fn(&str)) -> anyhow::
     }
     let sf = &p.model.surface;
     say!(
-        "surface          {}: {} boundary particles, {} fitted; particles' volume {:+.2e} of the body's",
+        "surface          {}: {} boundary particles, {} fitted; largest residual {:.4}; particles' volume {:+.2e} of the body's",
         sf.method,
         sf.boundary_particles,
         sf.corrected,
+        sf.max_residual,
         sf.particle_volume / sf.body_volume - 1.0
     );
     for d in &sc.derived {

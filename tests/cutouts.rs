@@ -6,6 +6,7 @@
 //! seeded ChaCha stream), and on random particles of several seeds and rotations.
 
 mod common;
+use common::says;
 
 use nalgebra::Vector2;
 use rand::rngs::ChaCha20Rng;
@@ -550,12 +551,6 @@ fn error_in(text: &str) -> String {
     match Scene::from_toml_str(text, &[]) {
         Ok(_) => panic!("accepted:\n{text}"),
         Err(e) => e.to_string(),
-    }
-}
-
-fn says(msg: &str, fragments: &[&str]) {
-    for f in fragments {
-        assert!(msg.contains(f), "message {msg:?} does not name {f:?}");
     }
 }
 

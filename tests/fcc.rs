@@ -1,6 +1,9 @@
 //! The 3D FCC lattice (issue "3D"): scenes of solid bodies and their bad input, the body's
 //! volume at any rotation and offset, and the elastic block against (E, ν).
 
+mod common;
+use common::says;
+
 use sppm::run::solid::fcc_body;
 use sppm::Scene;
 
@@ -28,13 +31,6 @@ fn error_of(text: &str, overrides: &[&str]) -> String {
     match scene(text, overrides) {
         Ok(_) => panic!("{overrides:?} was accepted"),
         Err(e) => e,
-    }
-}
-
-/// The message names every fragment.
-fn says(msg: &str, fragments: &[&str]) {
-    for f in fragments {
-        assert!(msg.contains(f), "message {msg:?} does not name {f:?}");
     }
 }
 
@@ -225,34 +221,16 @@ fn elastic_block_gives_e_and_nu_within_one_percent_at_three_orientations() {
             rotation_deg: rot,
             offset: Vector3::zeros(),
         };
-        let (e, nu) = fcc_block_modulus(20.0 * l0, 40.0 * l0, &lattice, "voronoi_fit").unwrap();
+        let (e, nu) = fcc_block_modulus(
+            20.0 * l0,
+            40.0 * l0,
+            &lattice,
+            sppm::scene::Surface::VoronoiFit,
+        )
+        .unwrap();
         assert!((e - 1.0).abs() < 0.01, "{rot:?}: E/E0 = {e}");
         assert!((nu - 1.0).abs() < 0.01, "{rot:?}: ν/ν0 = {nu}");
     }
-}
-
-/// E and ν as a testing machine reads them from particle positions and displacements: the
-/// stress F/A, the strains of an affine fit over the middle half of a W × W × H prism
-/// (z along H).
-fn read_modulus(x0: &[[f64; 3]], u: &[[f64; 3]], force: f64, w: f64, h: f64) -> (f64, f64) {
-    use nalgebra::{SMatrix, SVector};
-    let mut ata = SMatrix::<f64, 4, 4>::zeros();
-    let mut atb = [SVector::<f64, 4>::zeros(); 3];
-    for (x, ui) in x0.iter().zip(u) {
-        if (x[0] - 0.5 * w).abs() <= 0.25 * w
-            && (x[1] - 0.5 * w).abs() <= 0.25 * w
-            && (x[2] - 0.5 * h).abs() <= 0.25 * h
-        {
-            let row = SVector::<f64, 4>::new(x[0], x[1], x[2], 1.0);
-            ata += row * row.transpose();
-            for d in 0..3 {
-                atb[d] += row * ui[d];
-            }
-        }
-    }
-    let inv = ata.try_inverse().unwrap();
-    let (exx, eyy, ezz) = ((inv * atb[0])[0], (inv * atb[1])[1], (inv * atb[2])[2]);
-    (force / (w * w) / ezz, -0.5 * (exx + eyy) / ezz)
 }
 
 /// The whole 3D pipeline (scene → FCC body → groups → explicit run → outcome) on the shipped
@@ -263,6 +241,7 @@ fn read_modulus(x0: &[[f64; 3]], u: &[[f64; 3]], force: f64, w: f64, h: f64) -> 
 #[test]
 fn the_elastic_prism_runs_to_its_static_solution() {
     use nalgebra::Vector3;
+    use sppm::study::elastic_checks::prism_moduli;
     let sc = Scene::from_file(
         std::path::Path::new("lattices/elastic_block_3d.toml"),
         &["discretisation.spacing=0.005".to_string()],
@@ -273,7 +252,15 @@ fn the_elastic_prism_runs_to_its_static_solution() {
     assert_eq!(o.summary.status, "completed");
     assert_eq!(o.dim, 3);
     assert!(o.summary.max_kinetic_to_internal_energy < 5e-3);
-    let (e_run, nu_run) = read_modulus(&o.x0, &o.displacement, o.summary.final_force_n, w, h);
+    let vectors = |v: &[[f64; 3]]| v.iter().map(|&a| Vector3::from(a)).collect::<Vec<_>>();
+    let (e_run, nu_run) = prism_moduli(
+        &vectors(&o.x0),
+        &vectors(&o.displacement),
+        o.summary.final_force_n,
+        w,
+        h,
+    )
+    .unwrap();
     // the static solution of the same model
     let p = sppm::run::solid::prepare_solid(&sc, &|_| {}).unwrap();
     let m = &p.model;
@@ -287,9 +274,7 @@ fn the_elastic_prism_runs_to_its_static_solution() {
     sppm::solver::linear::LinearOperator::new(&m.mech, &m.particles.x0).internal_forces(&u, &mut f);
     let top = m.groups.iter().find(|g| g.name == "top").unwrap();
     let force = -top.members.iter().map(|&i| f[i as usize].z).sum::<f64>();
-    let x0: Vec<[f64; 3]> = m.particles.x0.iter().map(|x| [x.x, x.y, x.z]).collect();
-    let us: Vec<[f64; 3]> = u.iter().map(|v| [v.x, v.y, v.z]).collect();
-    let (e_static, nu_static) = read_modulus(&x0, &us, force, w, h);
+    let (e_static, nu_static) = prism_moduli(&m.particles.x0, &u, force, w, h).unwrap();
     println!("E run {e_run:.5e} static {e_static:.5e}; ν run {nu_run:.5} static {nu_static:.5}");
     assert!(
         (e_run / e_static - 1.0).abs() < 5e-3,

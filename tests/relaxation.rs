@@ -5,6 +5,7 @@
 //! bad keys are refused with the key, the value and what is allowed.
 
 mod common;
+use common::says;
 use common::*;
 use sppm::run::{prepare_model, RunOptions};
 use sppm::Scene;
@@ -154,12 +155,6 @@ fn error_of(overrides: &[&str]) -> String {
     match Scene::from_toml_str(&text, &o) {
         Ok(_) => panic!("{overrides:?} was accepted"),
         Err(e) => e.to_string(),
-    }
-}
-
-fn says(msg: &str, fragments: &[&str]) {
-    for f in fragments {
-        assert!(msg.contains(f), "message {msg:?} does not name {f:?}");
     }
 }
 

@@ -1,6 +1,9 @@
 //! Every scene-validation path: a bad scene stops before any work with one message naming
 //! the key, the value and what is allowed (ARCHITECTURE.md, "Interfaces").
 
+mod common;
+use common::says;
+
 use sppm::run::{prepare, prepare_model};
 use sppm::Scene;
 
@@ -42,13 +45,6 @@ fn error_of_text(text: &str) -> String {
     match Scene::from_toml_str(text, &[]) {
         Ok(_) => panic!("accepted:\n{text}"),
         Err(e) => e.to_string(),
-    }
-}
-
-/// The message names every fragment.
-fn says(msg: &str, fragments: &[&str]) {
-    for f in fragments {
-        assert!(msg.contains(f), "message {msg:?} does not name {f:?}");
     }
 }
 

@@ -4,7 +4,7 @@
 use super::Particles;
 use crate::geometry::Shape2;
 use crate::scene::{Edge, Selection};
-use nalgebra::Vector2;
+use nalgebra::{SVector, Vector2};
 
 /// A named set of particle indices (ascending).
 #[derive(Clone, Debug)]
@@ -96,29 +96,34 @@ fn peel_layers<const K: usize>(
     }
 }
 
+/// Members of particles whose index is `f`-selected (ascending).
+fn pick<const D: usize>(x0: &[SVector<f64, D>], f: &dyn Fn(&SVector<f64, D>) -> bool) -> Vec<u32> {
+    (0..x0.len())
+        .filter(|&i| f(&x0[i]))
+        .map(|i| i as u32)
+        .collect()
+}
+
+/// The one particle nearest `q` (none in an empty body).
+fn nearest<const D: usize>(x0: &[SVector<f64, D>], q: &SVector<f64, D>) -> Vec<u32> {
+    (0..x0.len())
+        .min_by(|&a, &b| {
+            (x0[a] - q)
+                .norm_squared()
+                .total_cmp(&(x0[b] - q).norm_squared())
+        })
+        .map(|i| vec![i as u32])
+        .unwrap_or_default()
+}
+
 /// Select the members of a group. Empty selections are reported by the caller.
 pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shape2) -> Vec<u32> {
     let pitch = 0.5 * 3f64.sqrt() * p.spacing;
     let eps = 1e-9 * p.spacing;
-    let pick = |f: &dyn Fn(&Vector2<f64>) -> bool| -> Vec<u32> {
-        (0..p.len())
-            .filter(|&i| f(&p.x0[i]))
-            .map(|i| i as u32)
-            .collect()
-    };
+    let pick = |f: &dyn Fn(&Vector2<f64>) -> bool| pick(&p.x0, f);
     match sel {
         Selection::All => (0..p.len() as u32).collect(),
-        Selection::Nearest { point } => {
-            let q = Vector2::new(point[0], point[1]);
-            (0..p.len())
-                .min_by(|&a, &b| {
-                    (p.x0[a] - q)
-                        .norm_squared()
-                        .total_cmp(&(p.x0[b] - q).norm_squared())
-                })
-                .map(|i| vec![i as u32])
-                .unwrap_or_default()
-        }
+        Selection::Nearest { point } => nearest(&p.x0, &Vector2::new(point[0], point[1])),
         Selection::Box { min, max } => pick(&|x| {
             x.x >= min[0] - eps && x.x <= max[0] + eps && x.y >= min[1] - eps && x.y <= max[1] + eps
         }),
@@ -190,26 +195,11 @@ pub fn select_3d<const K: usize>(
     use nalgebra::Vector3;
     let pitch = p.spacing / 2f64.sqrt();
     let eps = 1e-9 * p.spacing;
-    let pick = |f: &dyn Fn(&Vector3<f64>) -> bool| -> Vec<u32> {
-        (0..p.len())
-            .filter(|&i| f(&p.x0[i]))
-            .map(|i| i as u32)
-            .collect()
-    };
+    let pick = |f: &dyn Fn(&Vector3<f64>) -> bool| pick(&p.x0, f);
     let coords = |v: &[f64]| Vector3::new(v[0], v[1], v.get(2).copied().unwrap_or(0.0));
     match sel {
         Selection::All => (0..p.len() as u32).collect(),
-        Selection::Nearest { point } => {
-            let q = coords(point);
-            (0..p.len())
-                .min_by(|&a, &b| {
-                    (p.x0[a] - q)
-                        .norm_squared()
-                        .total_cmp(&(p.x0[b] - q).norm_squared())
-                })
-                .map(|i| vec![i as u32])
-                .unwrap_or_default()
-        }
+        Selection::Nearest { point } => nearest(&p.x0, &coords(point)),
         Selection::Box { min, max } => {
             let (lo, hi) = (coords(min), coords(max));
             pick(&|x| (0..3).all(|d| x[d] >= lo[d] - eps && x[d] <= hi[d] + eps))

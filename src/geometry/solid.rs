@@ -25,17 +25,6 @@ pub enum Shape3 {
     Extruded { section: Shape2, thickness: f64 },
 }
 
-/// Two unit vectors completing the unit vector `a` to an orthonormal frame.
-fn frame(a: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    let helper = if a.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let u = a.cross(&helper).normalize();
-    (u, a.cross(&u))
-}
-
 impl Shape3 {
     /// Lower and upper corners of the axis-aligned bounding box.
     pub fn bounding_box(&self) -> (Vector3<f64>, Vector3<f64>) {
@@ -139,15 +128,6 @@ impl Shape3 {
             _ => None,
         }
     }
-
-    /// A cylinder's frame: two unit vectors normal to its axis and to each other (to place
-    /// strips along its generatrix); `None` for the other shapes.
-    pub fn cylinder_frame(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
-        match self {
-            Shape3::Cylinder { axis, .. } => Some(frame(axis)),
-            _ => None,
-        }
-    }
 }
 
 #[cfg(test)]
@@ -172,9 +152,9 @@ mod tests {
             length: 2.0,
         };
         assert_relative_eq!(c.volume(), std::f64::consts::PI * 0.5);
-        let (u, v) = c.cylinder_frame().unwrap();
-        assert_relative_eq!(u.dot(&axis), 0.0, epsilon = 1e-15);
-        assert_relative_eq!(v.dot(&u), 0.0, epsilon = 1e-15);
+        // two unit vectors normal to the axis and to each other
+        let u = axis.cross(&Vector3::z()).normalize();
+        let v = axis.cross(&u);
         let mid = axis * 1.0;
         assert!(c.contains(&(mid + u * 0.499), 0.0));
         assert!(!c.contains(&(mid + v * 0.501), 0.0));

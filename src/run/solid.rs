@@ -47,23 +47,25 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
     })?;
     check_size(scene)?;
     let method = d.surface();
-    let clipped = match method {
-        Surface::VoronoiFit => true,
-        Surface::LatticeFit | Surface::Lattice => false,
-        Surface::Voronoi => return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+    if method == Surface::Voronoi {
+        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
             key: "discretisation.surface".into(),
             value: "\"voronoi\"".into(),
             allowed:
                 "\"voronoi_fit\" (box bodies), \"lattice_fit\" or \"lattice\" for the FCC lattice"
                     .into(),
-        })),
-    };
-    if clipped && solid.planes().is_none() {
-        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
-            key: "discretisation.surface".into(),
-            value: format!("\"voronoi_fit\" (the default) on body.shape = \"{}\"", scene.body.name()),
-            allowed: "\"lattice_fit\" (full cells, fitted boundary moduli) or \"lattice\" (the source) on a cylinder or a prism: their clipped 3D Voronoi cells are not available yet (a box has them)".into(),
         }));
+    }
+    // refused before the fill: a body without clipped cells under the default treatment
+    let no_cells = || {
+        RunError::Scene(crate::scene::SceneError::Invalid {
+        key: "discretisation.surface".into(),
+        value: format!("\"voronoi_fit\" (the default) on body.shape = \"{}\"", scene.body.name()),
+        allowed: "\"lattice_fit\" (full cells, fitted boundary moduli) or \"lattice\" (the source) on a cylinder or a prism: their clipped 3D Voronoi cells are not available yet (a box has them)".into(),
+    })
+    };
+    if method == Surface::VoronoiFit && solid.planes().is_none() {
+        return Err(no_cells());
     }
     let [ox, oy, oz] = d.offset3();
     let lattice = FccLattice {
@@ -79,28 +81,44 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
             p.len()
         )));
     }
-    if clipped {
-        p.volume = voronoi3::fcc_clipped_volumes(&p, &solid).expect("a box has planes");
+    let report =
+        surface_treatment(&mut p, &solid, method, m.youngs_modulus(), m.nu).ok_or_else(no_cells)?;
+    Ok((p, report))
+}
+
+/// The boundary treatment `method` of an FCC body in `solid` (`discretisation.surface`;
+/// "voronoi" is not offered in 3D) into its volumes and micro-moduli for (E, ν):
+/// `voronoi_fit` clips every cell to the body and fits the boundary particles
+/// ([`assign_moduli`]), `lattice_fit` fits them in full cells, `lattice` gives every particle
+/// the full cell and the bulk constants. `None` when `voronoi_fit` meets a body without
+/// clipped cells (not a convex polyhedron).
+pub fn surface_treatment(
+    p: &mut Particles<3, SLOTS>,
+    solid: &Shape3,
+    method: Surface,
+    e: f64,
+    nu: f64,
+) -> Option<SolidBody> {
+    if method == Surface::VoronoiFit {
+        p.volume = voronoi3::fcc_clipped_volumes(p, solid)?;
     }
-    let e = m.youngs_modulus();
-    let mut moduli = assign_moduli(&mut p, e, m.nu);
-    if method == Surface::Lattice {
-        let bulk = bulk_moduli(e, m.nu, d.spacing);
-        for i in 0..p.len() {
-            (p.a[i], p.b[i], p.c[i]) = (bulk.a, bulk.b, bulk.c);
-        }
-        moduli = ModuliReport {
-            bulk: p.len(),
+    let moduli = if method == Surface::Lattice {
+        let n = p.len();
+        let bulk = bulk_moduli(e, nu, p.spacing);
+        (p.a, p.b, p.c) = (vec![bulk.a; n], vec![bulk.b; n], vec![bulk.c; n]);
+        ModuliReport {
+            bulk: n,
             ..Default::default()
-        };
-    }
-    let report = SolidBody {
+        }
+    } else {
+        assign_moduli(p, e, nu)
+    };
+    Some(SolidBody {
         method: method.name(),
         body_volume: solid.volume(),
         particle_volume: p.volume.iter().sum(),
         moduli,
-    };
-    Ok((p, report))
+    })
 }
 
 /// The assembled elastic model of a 3D scene (FCC, 18 slots): body, groups, supports,
@@ -140,13 +158,7 @@ pub fn prepare_model_solid(
             "discretisation.lattice = \"fcc\" needs a solid body (box, cylinder or prism)".into(),
         )
     })?;
-    let section = match (&scene.body, &solid) {
-        (crate::scene::BodySpec::Prism { .. }, _) => Some(scene.shape()),
-        (_, Shape3::Cylinder { axis, .. }) if axis.x.abs() < 1e-12 && axis.y.abs() < 1e-12 => {
-            Some(scene.shape())
-        }
-        _ => None,
-    };
+    let section = scene.section_along_z();
     let (lo, hi) = solid.bounding_box();
     let extent = format!(
         "x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m, z ∈ [{:.6}, {:.6}] m",
@@ -242,9 +254,9 @@ pub fn bulk_moduli(e: f64, nu: f64, l0: f64) -> FccModuli {
 pub fn assign_moduli(p: &mut Particles<3, SLOTS>, e: f64, nu: f64) -> ModuliReport {
     let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, Plane::Stress);
     let mut report = ModuliReport::default();
+    let bulk = bulk_moduli(e, nu, p.spacing);
     for i in 0..p.len() {
         let ell = p.length[i];
-        let bulk = bulk_moduli(e, nu, p.spacing);
         let fraction = p.volume[i] / cell_volume(p.spacing);
         let (mut a, mut b, mut c) = (bulk.a * fraction, bulk.b * fraction, bulk.c * fraction);
         if p.bond_count(i) == SLOTS {

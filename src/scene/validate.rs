@@ -834,6 +834,17 @@ impl Scene {
         section_shape(&self.body)
     }
 
+    /// The 2D section a 3D body keeps all along z (a prism's, a cylinder's along z: the
+    /// plane in which its strips are drawn); `None` for other bodies.
+    pub fn section_along_z(&self) -> Option<crate::geometry::Shape2> {
+        let along_z = match &self.body {
+            BodySpec::Prism { .. } => true,
+            BodySpec::Cylinder { axis, .. } => z_axis_only(axis),
+            _ => false,
+        };
+        along_z.then(|| self.shape())
+    }
+
     /// The solid of a 3D scene: a box, a cylinder (its axis normalised), or the prism of
     /// [`Self::shape`] (the section with the cutouts); `None` for a 2D body.
     pub fn solid(&self) -> Option<crate::geometry::Shape3> {
@@ -862,6 +873,12 @@ impl Scene {
             _ => None,
         }
     }
+}
+
+/// Whether a cylinder's axis runs along z.
+fn z_axis_only(axis: &[f64; 3]) -> bool {
+    let a = nalgebra::Vector3::from(*axis).normalize();
+    a.x.abs() < 1e-12 && a.y.abs() < 1e-12
 }
 
 /// The smallest overall dimension (m) of a body shape (`shape`: its 2D shape).
@@ -929,7 +946,7 @@ fn section_shape(body: &BodySpec) -> crate::geometry::Shape2 {
         } => {
             let a = nalgebra::Vector3::from(*axis).normalize();
             let r = 0.5 * diameter;
-            if a.x.abs() < 1e-12 && a.y.abs() < 1e-12 {
+            if z_axis_only(axis) {
                 return Shape2::Disc {
                     centre: Vector2::new(base[0], base[1]),
                     radius: r,

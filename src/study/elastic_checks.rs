@@ -212,34 +212,25 @@ pub fn hole_stress(width: f64, radius: f64, p: &Placement) -> Result<HoleStress,
 /// face held in z, those within 1.5·L0 of the top face pulled 1e-4·H in z, the side faces
 /// free; σ = F/W² from the reaction of the pulled particles, ε_zz and the lateral strains
 /// (mean of ε_xx and ε_yy) from an affine fit of the displacements over the middle half of
-/// the block. `surface` as `discretisation.surface`: "voronoi_fit" (cells clipped to the
-/// body, boundary moduli fitted), "lattice_fit" (full cells, boundary moduli fitted) or
-/// "lattice" (full cells, the bulk constants everywhere: the source).
+/// the block. `surface` as `discretisation.surface` of a 3D scene
+/// (`run::solid::surface_treatment`: "voronoi_fit" clips the cells to the box).
 pub fn fcc_block_modulus(
     width: f64,
     height: f64,
     lattice: &crate::discretise::fcc::FccLattice,
-    surface: &str,
+    surface: crate::scene::Surface,
 ) -> Result<(f64, f64), RunError> {
     use crate::geometry::Shape3;
-    use crate::run::solid::{assign_moduli, bulk_moduli};
+    use crate::run::solid::surface_treatment;
     use crate::solver::mechanics::Mechanics;
-    use nalgebra::{SMatrix, SVector};
     let shape = Shape3::Box {
         origin: Vector3::zeros(),
         size: Vector3::new(width, width, height),
     };
     let mut p = lattice.fill(&shape);
     let n = p.len();
-    if surface == "voronoi_fit" {
-        p.volume = crate::discretise::voronoi3::fcc_clipped_volumes(&p, &shape)
-            .expect("a box is a convex polyhedron");
-    }
-    assign_moduli(&mut p, E, NU);
-    if surface == "lattice" {
-        let m = bulk_moduli(E, NU, lattice.spacing);
-        (p.a, p.b, p.c) = (vec![m.a; n], vec![m.b; n], vec![m.c; n]);
-    }
+    surface_treatment(&mut p, &shape, surface, E, NU)
+        .ok_or_else(|| RunError::Setup("a box has clipped cells".into()))?;
     let mech = Mechanics::new(&p, &vec![2400.0; n]);
     let band = 1.5 * lattice.spacing;
     let strain = 1e-4;
@@ -260,10 +251,27 @@ pub fn fcc_block_modulus(
     let mut f = vec![Vector3::zeros(); n];
     LinearOperator::new(&mech, &p.x0).internal_forces(&u, &mut f);
     let force = -top.iter().map(|&i| f[i].z).sum::<f64>();
-    // affine fit u ≈ G·x + c over the middle half
+    let (e, nu) = prism_moduli(&p.x0, &u, force, width, height)
+        .ok_or_else(|| RunError::Setup("the middle half of the block holds no particles".into()))?;
+    Ok((e / E, nu / NU))
+}
+
+/// (E, ν) of a prism W × W × H (z along H, lower corner at the origin) in uniaxial tension
+/// along z as a testing machine reads them: σ = `force`/W², the strains from an affine fit
+/// u ≈ G·x + c of the displacements `u` of the particles at `x0` over the middle half of the
+/// prism (ν the mean of the two lateral ratios); `None` when the middle half cannot carry the
+/// fit.
+pub fn prism_moduli(
+    x0: &[Vector3<f64>],
+    u: &[Vector3<f64>],
+    force: f64,
+    width: f64,
+    height: f64,
+) -> Option<(f64, f64)> {
+    use nalgebra::{SMatrix, SVector};
     let mut ata = SMatrix::<f64, 4, 4>::zeros();
     let mut atb = [SVector::<f64, 4>::zeros(); 3];
-    for (x, ui) in p.x0.iter().zip(&u) {
+    for (x, ui) in x0.iter().zip(u) {
         let inside = (x.x - 0.5 * width).abs() <= 0.25 * width
             && (x.y - 0.5 * width).abs() <= 0.25 * width
             && (x.z - 0.5 * height).abs() <= 0.25 * height;
@@ -275,8 +283,7 @@ pub fn fcc_block_modulus(
             }
         }
     }
-    let inv = ata.try_inverse().expect("the middle half holds particles");
+    let inv = ata.try_inverse()?;
     let (exx, eyy, ezz) = ((inv * atb[0])[0], (inv * atb[1])[1], (inv * atb[2])[2]);
-    let sigma = force / (width * width);
-    Ok((sigma / ezz / E, -0.5 * (exx + eyy) / ezz / NU))
+    Some((force / (width * width) / ezz, -0.5 * (exx + eyy) / ezz))
 }

@@ -303,3 +303,11 @@ pub fn split_cylinder_peak(ft: f64, d: f64, h: f64, b: f64) -> f64 {
     let beta = b / d;
     std::f64::consts::FRAC_PI_2 * ft * d * h / (1.0 - beta * beta).powf(1.5)
 }
+
+/// The message names every fragment (the error tests: one message naming the key, the
+/// value and what is allowed).
+pub fn says(msg: &str, fragments: &[&str]) {
+    for f in fragments {
+        assert!(msg.contains(f), "message {msg:?} does not name {f:?}");
+    }
+}
