@@ -181,7 +181,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             };
             if sc.discretisation.dim() == 3 {
                 let p = sppm::run::solid::prepare_solid(&sc, &stage)?;
-                check(&sc, mem, &stage, p, &sppm::run::execute::simulation_of)?;
+                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
             } else if sppm::run::prepare::slots_of(&sc) == sppm::discretise::random::SLOTS_2D {
                 let p = prepare_with::<{ sppm::discretise::random::SLOTS_2D }>(&sc, &stage)?;
                 check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;

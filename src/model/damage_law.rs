@@ -85,6 +85,9 @@ where
     pub undamaged: bool,
     /// Micro-modulus a_i.
     pub a: f64,
+    /// The FCC second-neighbour modulus c_i and its first slot (MODEL.md §3 erratum): slots
+    /// `first..K` have the bond modulus a_i + c_i; `None` without second neighbours.
+    pub second: Option<(f64, usize)>,
     /// The undamaged dilatation term b_i·Σ S_e (for the force states of plastic flow).
     pub b_theta_elastic: f64,
     /// Every particle's length scale L0,i (m; read through [`ParticleBonds::length`]).
@@ -104,6 +107,16 @@ where
     #[inline(always)]
     pub fn length(&self) -> f64 {
         self.lengths[self.i]
+    }
+
+    /// The particle's own bond modulus in slot k: a_i, or a_i + c_i in a second-neighbour
+    /// slot (MODEL.md §3 erratum), for its force states (3.8).
+    #[inline(always)]
+    pub fn modulus(&self, k: usize) -> f64 {
+        match self.second {
+            Some((c, first)) if k >= first => self.a + c,
+            _ => self.a,
+        }
     }
 }
 

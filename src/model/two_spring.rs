@@ -165,7 +165,7 @@ where
                     let mut fs = [0.0; K];
                     for (k, f) in fs.iter_mut().enumerate() {
                         if b.used[k] {
-                            *f = force_state(b.a, b.elastic[k], b.b_theta_elastic);
+                            *f = force_state(b.modulus(k), b.elastic[k], b.b_theta_elastic);
                         }
                     }
                     plasticity::flow(&fs, b.used, ratio, law.fy / law.e, sps);

@@ -6,6 +6,7 @@ use super::summary::{point3, summarise, voigt6, Finished, Outcome, SolverReport}
 use super::{stress_recovery, RunError, RunOptions};
 use crate::discretise::random;
 use crate::material::properties;
+use crate::model::dimension::{Dim, Dimension};
 use crate::model::force_state::{dilatation_term, force_state};
 use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
@@ -67,7 +68,7 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
     pool.install(|| {
         if scene.discretisation.dim() == 3 {
             let p = super::solid::prepare_solid(scene, &|_| {})?;
-            run_prepared(p, opts, threads, &simulation_of, &stress_3d)
+            run_prepared(p, opts, threads, &build_simulation, &stress_3d)
         } else if slots_of(scene) == random::SLOTS_2D {
             let p = prepare_with::<{ random::SLOTS_2D }>(scene, &|_| {})?;
             run_prepared(p, opts, threads, &build_simulation, &stress_2d)
@@ -83,13 +84,16 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
     })
 }
 
-/// The simulation of a prepared scene, at rest, taking over the model's arrays (no copy);
-/// with `[concrete]`, the damage and plasticity kernel is on.
-pub fn build_simulation<const K: usize>(p: &mut Prepared<K>) -> Simulation<2, K> {
+/// The simulation of a prepared scene (2D or 3D), at rest, taking over the model's arrays (no
+/// copy); with `[concrete]`, the damage and plasticity kernel is on.
+pub fn build_simulation<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> Simulation<D, K>
+where
+    Dim<D>: Dimension<D>,
+{
     let mut sim = simulation_of(p);
     if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
         let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
-        let mut c: Concrete<2, K> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
+        let mut c: Concrete<D, K> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
         if p.model.random.is_some() {
             c = c.with_neighbourhood_criteria(&p.model.particles);
         }
@@ -145,15 +149,21 @@ fn stress_2d<const K: usize>(p: &Prepared<K>, sim: &Simulation<2, K>) -> Recover
     (stress.iter().map(voigt6).collect(), damage)
 }
 
-/// The stress of a 3D (elastic) run: D·ε_i with ε_i each particle's least-squares strain of
-/// its own bond stretches (MODEL.md §7, §13), as in the bulk of 2D.
+/// The stress of a 3D run: D·ε_i with ε_i each particle's least-squares strain of its own
+/// (damaged elastic) bond stretches (MODEL.md §7, §13), as in the bulk of 2D; with damage,
+/// each particle's damage.
 fn stress_3d<const K: usize>(p: &Prepared<K, 3>, sim: &Simulation<3, K>) -> Recovered {
+    let x = &sim.state.x;
+    let (strain, damage) = match &sim.inelastic {
+        Some(model) => (model.particle_strain(&sim.mech, x), Some(model.damage())),
+        None => (stress_recovery::elastic_strain(&p.model, x), None),
+    };
     (
-        stress_recovery::own_stress_3d(&p.model, &sim.state.x)
+        stress_recovery::stress_3d(&p.model, &strain)
             .iter()
             .map(voigt6)
             .collect(),
-        None,
+        damage,
     )
 }
 

@@ -1,8 +1,9 @@
 //! The body and model of a 3D scene (`discretisation.lattice = "fcc"`, issue "3D"): the FCC
 //! lattice in the scene's solid, its boundary treatment and micro-moduli, its groups and
 //! supports ([`prepare_model_solid`]), then the same dynamics as 2D ([`prepare_solid`]).
-//! Elastic scenes run; `[concrete]` and random fields in 3D are refused until the concrete
-//! kernels carry the second-neighbour modulus c.
+//! `[concrete]` runs the same damage kernel as 2D (`solver::concrete`, with the FCC
+//! second-neighbour modulus c); random fields in 3D are refused (they are sampled in the
+//! plane).
 
 use super::prepare::{
     check_size, dynamics, estimated_particles, supports, Model, Prepared, SurfaceCorrection,
@@ -134,13 +135,6 @@ pub fn prepare_model_solid(
             allowed: allowed.into(),
         })
     };
-    if scene.concrete.is_some() {
-        return Err(refuse(
-            "concrete",
-            "a [concrete] section".into(),
-            "absent in 3D for now: the 3D run is elastic until the concrete kernels carry the FCC second-neighbour modulus (issue \"3D\")",
-        ));
-    }
     if !scene.random_field.is_empty() {
         return Err(refuse(
             "random_field",

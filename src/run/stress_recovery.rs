@@ -163,17 +163,17 @@ pub fn elastic_stress<const K: usize>(model: &Model<K>, x: &[Vector2<f64>]) -> V
     recovered_stress(model, &strain)
 }
 
-/// The stress D·ε_i of each particle of a 3D model at positions x, ε_i the least-squares
-/// strain of its own total bond stretches ([`elastic_strain`]; MODEL.md §7, §13): exact in
-/// the bulk of the FCC lattice under a homogeneous strain. The surface recovery of 2D (the
-/// affine patch fit) is not carried to 3D yet.
-pub fn own_stress_3d<const K: usize>(
+/// The stress D·ε_i of each particle of a 3D model from its strain ε_i (the least-squares
+/// strain of its own bond stretches, [`elastic_strain`] or the concrete kernel's damaged
+/// elastic one; MODEL.md §7, §13): exact in the bulk of the FCC lattice under a homogeneous
+/// strain. The surface recovery of 2D (the affine patch fit) is not carried to 3D yet.
+pub fn stress_3d<const K: usize>(
     model: &Model<K, 3>,
-    x: &[nalgebra::Vector3<f64>],
+    strain: &[nalgebra::Matrix3<f64>],
 ) -> Vec<nalgebra::Matrix3<f64>> {
     let m = &model.scene.material;
     let d = <Dim<3> as Dimension<3>>::elasticity(m.youngs_modulus(), m.nu, m.plane());
-    elastic_strain(model, x)
+    strain
         .iter()
         .map(|e| Dim::<3>::stress_of_strain(&d, e))
         .collect()

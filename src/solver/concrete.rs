@@ -400,6 +400,7 @@ where
         let sc = match slot::<D, K, L, FULL>(m, c, x, i, k) {
             Some(b) => {
                 let j = m.neighbours[i][k] as usize;
+                let (mi, mj) = m.bond_moduli(i, j, k);
                 s.st[k] = b.st;
                 s.se[k] = b.se;
                 s.dse[k] = b.d * b.se;
@@ -409,7 +410,7 @@ where
                 s.same &= s.dse[k] == s.st[k];
                 SlotCache {
                     inv_len: b.inv_len,
-                    d_a_se: damaged_axial(b.d, m.a[i], m.a[j], b.se),
+                    d_a_se: damaged_axial(b.d, mi, mj, b.se),
                     sd: b.sd,
                     d: b.d,
                 }
@@ -464,6 +465,7 @@ where
         used: &s.used,
         undamaged: s.same,
         a: m.a[i],
+        second: m.second.as_ref().map(|s| (s.c[i], s.first_slot)),
         b_theta_elastic: dilatation_term(m.b[i], s.theta_e),
         lengths: &c.length,
         criteria_strain: mean_strain.as_ref(),
@@ -693,7 +695,6 @@ pub fn step<
     Dim<D>: Dimension<D>,
 {
     debug_assert!(FULL || c.kernel() == KernelSet::Tension);
-    m.assert_no_second("the concrete kernel (2D only for now)");
     pass_state::<D, K, L, FULL>(m, c, &st.x, &mut st.b_theta);
     #[cfg(target_arch = "x86_64")]
     let avx = c.simd && use_avx() && super::kernel::avx::vector_update::<D>();
@@ -734,7 +735,6 @@ pub fn internal_forces<const D: usize, const K: usize, L: DamageLaw<D, K>>(
 where
     Dim<D>: Dimension<D>,
 {
-    m.assert_no_second("the concrete kernel (2D only for now)");
     let mut bt = vec![0.0; x.len()];
     match c.kernel() {
         KernelSet::Tension => pass_state::<D, K, L, false>(m, c, x, &mut bt),
@@ -762,7 +762,6 @@ pub fn internal_energy<const D: usize, const K: usize, L: DamageLaw<D, K>>(
 where
     Dim<D>: Dimension<D>,
 {
-    m.assert_no_second("the concrete energy (2D only for now)");
     let per_particle: Vec<f64> = (0..x.len())
         .into_par_iter()
         .with_min_len(256)
@@ -771,7 +770,7 @@ where
             let mut u = 0.0;
             for (k, s) in sl.iter().enumerate() {
                 if let Some(s) = s {
-                    let fs = damaged_force_state(s.d, s.sd, m.a[i], s.se, bt);
+                    let fs = damaged_force_state(s.d, s.sd, m.slot_modulus(i, k), s.se, bt);
                     u += bond_energy(s.se, fs, m.inv_l0[i][k]);
                 }
             }
@@ -792,7 +791,6 @@ pub fn particle_stress<const D: usize, const K: usize, L: DamageLaw<D, K>>(
 where
     Dim<D>: Dimension<D>,
 {
-    m.assert_no_second("the concrete stress (2D only for now)");
     (0..x.len())
         .map(|i| {
             let (sl, bt) = slots::<D, K, L, true>(m, c, x, i);
@@ -802,7 +800,7 @@ where
                     acc.add(
                         &s.e,
                         1.0 / m.inv_l0[i][k],
-                        damaged_force_state(s.d, s.sd, m.a[i], s.se, bt),
+                        damaged_force_state(s.d, s.sd, m.slot_modulus(i, k), s.se, bt),
                     );
                 }
             }
@@ -951,6 +949,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::aligned::CollectAligned;
     use crate::discretise::hex::HexLattice;
     use crate::discretise::random::{self, RandomParticles};
     use crate::geometry::Shape2;
@@ -959,18 +958,26 @@ mod tests {
     use nalgebra::{Matrix2, Vector2};
 
     /// The bench's concrete law, with or without the compressive branch and plasticity.
-    fn law(full: bool) -> TwoSpring<2> {
+    fn law<const D: usize>(full: bool) -> TwoSpring<D>
+    where
+        Dim<D>: Dimension<D>,
+    {
         TwoSpring::new(ConcreteLaw::table1(full), None)
     }
 
     /// A block strained by up to ±2·f't/E per bond, with every kind of committed state:
     /// intact, initiated, partly damaged in tension and compression, fully damaged (w = 1,
     /// where the series factor is 0/0), plastic stretch in every bond.
-    fn damaged<const K: usize>(
-        p: &Particles<2, K>,
+    /// With 18 slots the particles also get FCC second-neighbour moduli c (about −0.65·a, in
+    /// slots 12..18).
+    fn damaged<const D: usize, const K: usize>(
+        p: &Particles<D, K>,
         full: bool,
         seed: u64,
-    ) -> (Mechanics<2, K>, Concrete<2, K>, Vec<Vector2<f64>>) {
+    ) -> (Mechanics<D, K>, Concrete<D, K>, Vec<SVector<f64, D>>)
+    where
+        Dim<D>: Dimension<D>,
+    {
         let n = p.len();
         let mut r = Lcg(seed);
         let mut m = Mechanics::new(p, &vec![2400.0; n]);
@@ -979,6 +986,12 @@ mod tests {
             m.b[i] = -1e6 * (1.0 + 0.1 * r.next());
             m.c_in[i] = 5.0 * (1.0 + r.next());
             m.c_ex[i] = if i % 3 == 0 { 0.0 } else { 2.0 * r.next() };
+        }
+        if let Some(first_slot) = crate::solver::mechanics::first_second_slot(K) {
+            let c = (0..n)
+                .map(|i| -0.65 * m.a[i] * (1.0 + 0.05 * r.next()))
+                .collect_aligned();
+            m.second = Some(crate::solver::mechanics::SecondNeighbours { c, first_slot });
         }
         let mut c = Concrete::new(law(full), p);
         let mut w = || match (r.next() * 10.0) as u32 {
@@ -1002,38 +1015,41 @@ mod tests {
             }
         }
         let eps = 2.0 * 2.6168e6 / 30e9;
-        let x = p
-            .x0
-            .iter()
-            .map(|x0| x0 + Vector2::new(r.next() - 0.3, r.next() - 0.5) * eps * 40.0 * p.spacing)
-            .map(|x| x * (1.0 + 0.5 * eps))
-            .collect();
+        let x =
+            p.x0.iter()
+                .map(|x0| {
+                    let shift = SVector::<f64, D>::from_fn(|c, _| r.next() - [0.3, 0.5, 0.4][c]);
+                    x0 + shift * eps * 40.0 * p.spacing
+                })
+                .map(|x| x * (1.0 + 0.5 * eps))
+                .collect();
         (m, c, x)
     }
 
     /// Pass 1 through the SIMD blocks and through the scalar chunks, on 1 and 2 threads,
     /// against `update_state` particle by particle: the same bits in bθ, the trial state, the
     /// plastic stretch states, the slot cache and the neighbourhood's strains.
-    fn check_pass_state<const K: usize, const FULL: bool>(p: &Particles<2, K>, nb: bool) {
+    fn check_pass_state<const D: usize, const K: usize, const FULL: bool>(
+        p: &Particles<D, K>,
+        nb: bool,
+    ) where
+        Dim<D>: Dimension<D>,
+    {
         let (m, mut c, x) = damaged(p, FULL, 99);
         if nb {
             c = c.with_neighbourhood_criteria(p);
             let mut r = Lcg(5);
             for e in c.neighbourhood.as_mut().unwrap().strain.iter_mut() {
-                *e = Matrix2::new(
-                    r.next() - 0.5,
-                    0.3 * r.next(),
-                    0.3 * r.next(),
-                    r.next() - 0.5,
-                ) * 3e-3;
+                let t = Tensor::<D>::from_fn(|_, _| r.next() - 0.5);
+                *e = (t + t.transpose()) * 1.5e-3;
             }
         }
         let n = p.len();
         let mut want = c.clone();
         let mut want_bt = vec![0.0; n];
-        let mut own = vec![Tensor::<2>::zeros(); n];
+        let mut own = vec![Tensor::<D>::zeros(); n];
         for i in 0..n {
-            want_bt[i] = update_state::<2, K, TwoSpring<2>, FULL>(
+            want_bt[i] = update_state::<D, K, TwoSpring<D>, FULL>(
                 &m,
                 &c,
                 &x,
@@ -1046,7 +1062,7 @@ mod tests {
             );
         }
         let bits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
-        let state = |c: &Concrete<2, K>| {
+        let state = |c: &Concrete<D, K>| {
             let mut v = Vec::new();
             for s in c.trial.iter() {
                 v.extend([
@@ -1091,7 +1107,7 @@ mod tests {
                 let mut got = c.clone();
                 got.simd = simd;
                 let mut bt = vec![0.0; n];
-                pool.install(|| pass_state::<2, K, TwoSpring<2>, FULL>(&m, &mut got, &x, &mut bt));
+                pool.install(|| pass_state::<D, K, TwoSpring<D>, FULL>(&m, &mut got, &x, &mut bt));
                 assert_eq!(
                     bits(&bt),
                     bits(&want_bt),
@@ -1108,24 +1124,32 @@ mod tests {
         let mut r = Lcg(17);
         st.x.copy_from_slice(&x);
         for (v, f) in st.v.iter_mut().zip(st.force_prev.iter_mut()) {
-            *v = Vector2::new(r.next() - 0.5, r.next() - 0.5) * 1e-2;
-            *f = Vector2::new(r.next() - 0.5, r.next() - 0.5) * 1e3;
+            *v = SVector::<f64, D>::from_fn(|_, _| r.next() - 0.5) * 1e-2;
+            *f = SVector::<f64, D>::from_fn(|_, _| r.next() - 0.5) * 1e3;
         }
-        check_steps::<K, FULL, false, true>(&m, &c, &st);
-        check_steps::<K, FULL, true, false>(&m, &c, &st);
+        check_steps::<D, K, FULL, false, true>(&m, &c, &st);
+        check_steps::<D, K, FULL, true, false>(&m, &c, &st);
     }
 
     /// Three steps with and without the SIMD blocks: the same bits in every output.
-    fn check_steps<const K: usize, const FULL: bool, const LAG: bool, const DAMP: bool>(
-        m: &Mechanics<2, K>,
-        c: &Concrete<2, K>,
-        st0: &crate::solver::kernel::State<2>,
-    ) {
+    fn check_steps<
+        const D: usize,
+        const K: usize,
+        const FULL: bool,
+        const LAG: bool,
+        const DAMP: bool,
+    >(
+        m: &Mechanics<D, K>,
+        c: &Concrete<D, K>,
+        st0: &crate::solver::kernel::State<D>,
+    ) where
+        Dim<D>: Dimension<D>,
+    {
         let run = |simd: bool| {
             let (mut c, mut st) = (c.clone(), st0.clone());
             c.simd = simd;
             for _ in 0..3 {
-                step::<2, K, TwoSpring<2>, LAG, DAMP, FULL>(m, &mut c, &mut st, 1e-8);
+                step::<D, K, TwoSpring<D>, LAG, DAMP, FULL>(m, &mut c, &mut st, 1e-8);
                 std::mem::swap(&mut st.x, &mut st.x_next);
                 std::mem::swap(&mut st.v, &mut st.v_next);
             }
@@ -1182,10 +1206,29 @@ mod tests {
         }
         let (hex, rnd) = bodies();
         assert!(hex.len() % LANES != 0, "{}", hex.len());
-        check_pass_state::<6, false>(&hex, false);
-        check_pass_state::<6, true>(&hex, false);
-        check_pass_state::<12, false>(&rnd, true);
-        check_pass_state::<12, true>(&rnd, true);
+        check_pass_state::<2, 6, false>(&hex, false);
+        check_pass_state::<2, 6, true>(&hex, false);
+        check_pass_state::<2, 12, false>(&rnd, true);
+        check_pass_state::<2, 12, true>(&rnd, true);
+    }
+
+    /// The same in 3D on an FCC block with second-neighbour moduli c and weighted
+    /// dilatations (slots 12..18 take a + c, MODEL.md §3 erratum), not a multiple of 4.
+    #[test]
+    fn fcc_pass_state_with_second_neighbours_simd_matches_scalar_bitwise() {
+        let fcc = crate::discretise::fcc::FccLattice {
+            spacing: 2e-3,
+            rotation_deg: [20.0, 10.0, 5.0],
+            offset: nalgebra::Vector3::zeros(),
+        }
+        .fill(&crate::geometry::solid::Shape3::Box {
+            origin: nalgebra::Vector3::zeros(),
+            size: nalgebra::Vector3::new(0.013, 0.011, 0.015),
+        });
+        assert!(fcc.len() % LANES != 0 && fcc.len() > 200, "{}", fcc.len());
+        assert!(fcc.weighted_dilatation);
+        check_pass_state::<3, 18, false>(&fcc, false);
+        check_pass_state::<3, 18, true>(&fcc, false);
     }
 
     /// Particle 0 with neighbours 1 and 2 (and an empty slot): the mean weighs each strain by

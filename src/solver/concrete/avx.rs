@@ -122,6 +122,16 @@ pub(super) unsafe fn slot_block<
     let half = _mm256_set1_pd(0.5);
     let xi = load_own(x, i0);
     let ai = _mm256_loadu_pd(m.a.as_ptr().add(i0));
+    // second-neighbour moduli (FCC, MODEL.md §3 erratum): c per particle, a_i + c_i and the
+    // first second-neighbour slot (K: none)
+    let (sc, aci, first): (&[f64], __m256d, usize) = match &m.second {
+        Some(s) => (
+            &s.c[..],
+            _mm256_add_pd(ai, _mm256_loadu_pd(s.c.as_ptr().add(i0))),
+            s.first_slot,
+        ),
+        None => (&[], ai, K),
+    };
     // (w_t, w_c) of the block's own particles
     let (wti, wci) = series_damage(c, [i0, i0 + 1, i0 + 2, i0 + 3]);
     let mut theta = zero;
@@ -177,9 +187,15 @@ pub(super) unsafe fn slot_block<
         let (d, sd) = (_mm256_and_pd(d, occ), _mm256_and_pd(sd, occ));
         // 1/len, from which pass 2 recomputes e = dx·(1/len)
         let rinv = _mm256_and_pd(_mm256_div_pd(one, len), occ);
-        // damaged_axial: d·((a_i + a_j)·S_e)
+        // damaged_axial: d·((m_i + m_j)·S_e) with the bond moduli (a_i, a_j), or
+        // (a_i + c_i, a_j + c_j) in a second-neighbour slot (`Mechanics::bond_moduli`)
         let aj = gather(&m.a, &j);
-        let d_a_se = _mm256_mul_pd(d, _mm256_mul_pd(_mm256_add_pd(ai, aj), se));
+        let (mi, mj) = if k >= first {
+            (aci, _mm256_add_pd(aj, gather(sc, &j)))
+        } else {
+            (ai, aj)
+        };
+        let d_a_se = _mm256_mul_pd(d, _mm256_mul_pd(_mm256_add_pd(mi, mj), se));
         let dse = _mm256_mul_pd(d, se);
         let sd_se = _mm256_mul_pd(sd, se);
         // the dilatation sums, weighted for random particles as `weighted` does
