@@ -198,13 +198,11 @@ fn fcc_damage_kernel_carries_the_second_neighbour_modulus() {
     let v = vec![Vector3::zeros(); n];
     let scale = f.iter().map(|f| f.norm()).fold(0.0, f64::max);
     assert!(scale > 0.0);
-    for i in 0..n {
+    for (i, fi) in f.iter().enumerate() {
         let fe = particle_force::<3, 18, false>(&m, &x, &v, &bt, i).0;
         assert!(
-            (f[i] - fe).norm() <= 1e-12 * scale,
-            "particle {i}: damage kernel {:?}, elastic kernel {:?}",
-            f[i],
-            fe
+            (fi - fe).norm() <= 1e-12 * scale,
+            "particle {i}: damage kernel {fi:?}, elastic kernel {fe:?}"
         );
     }
     // with c left out the forces differ: the test sees the modulus
