@@ -145,7 +145,7 @@ fn fcc_block() -> (Particles<3, 18>, Mechanics<3, 18>) {
         offset: Vector3::new(0.001, 0.002, 0.0),
     }
     .fill(&shape);
-    p.volume = sppm::discretise::voronoi3::fcc_clipped_volumes(&p, &shape).unwrap();
+    p.volume = sppm::discretise::voronoi3::fcc_clipped_volumes(&p, &shape);
     sppm::run::solid::assign_moduli(&mut p, law().e, law().nu);
     let m = Mechanics::new(&p, &vec![2400.0; p.len()]);
     assert!(m.second.is_some() && m.dilatation_weight.is_some());

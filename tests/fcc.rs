@@ -169,41 +169,50 @@ fn a_box_body_carries_its_volume_at_any_rotation_and_offset() {
     }
 }
 
+/// Cylinders and prisms carry their volume too (cells clipped to the body by slices,
+/// `discretise::voronoi3`), as the scenes build them; and 3D scenes with `[concrete]` build
+/// the damage kernel.
 #[test]
-fn clipped_cells_need_a_box_and_3d_concrete_is_refused_until_it_exists() {
-    let cylinder = BLOCK.replace(
-        "shape = \"box\"\nsize = [0.012, 0.010, 0.016]\norigin = [0.001, -0.002, 0.0]",
-        "shape = \"cylinder\"\ndiameter = 0.01\nlength = 0.02",
-    );
-    let sc = scene(&cylinder, &[]).unwrap();
-    let e = fcc_body(&sc).unwrap_err().to_string();
-    says(
-        &e,
-        &[
-            "discretisation.surface",
-            "voronoi_fit",
-            "cylinder",
-            "lattice_fit",
-        ],
-    );
-    let sc = scene(&cylinder, &["discretisation.surface=\"lattice_fit\""]).unwrap();
-    let (p, body) = fcc_body(&sc).unwrap();
-    // full cells: the particle count × the cell volume, within a surface layer of the volume
-    let v = std::f64::consts::PI * 0.005 * 0.005 * 0.02;
-    assert!((body.body_volume / v - 1.0).abs() < 1e-12);
-    assert!(p.len() > 1000);
-    // the 2D assembly names a 3D scene for what it is, and 3D concrete waits for its kernels
+fn cylinders_and_prisms_carry_their_volume_and_3d_concrete_prepares() {
+    let bodies = [
+        (
+            "shape = \"cylinder\"\ndiameter = 0.01\nlength = 0.02\naxis = [0.3, 1.0, 0.2]",
+            std::f64::consts::PI * 0.005 * 0.005 * 0.02,
+        ),
+        (
+            "shape = \"prism\"\nthickness = 0.008\nsection = { shape = \"dogbone\", size = 0.01 }",
+            0.0,
+        ),
+    ];
+    for (body, v) in bodies {
+        let text = BLOCK.replace(
+            "shape = \"box\"\nsize = [0.012, 0.010, 0.016]\norigin = [0.001, -0.002, 0.0]",
+            body,
+        );
+        for rot in ["[0.0, 0.0, 0.0]", "[30.0, 20.0, 10.0]"] {
+            let sc = scene(&text, &[&format!("discretisation.rotation_deg={rot}")]).unwrap();
+            let (p, report) = fcc_body(&sc).unwrap();
+            let want = if v > 0.0 { v } else { report.body_volume };
+            assert!((report.body_volume / want - 1.0).abs() < 1e-12);
+            let total: f64 = p.volume.iter().sum();
+            assert!(
+                (total / want - 1.0).abs() < 1e-9,
+                "{body} at {rot}: particles' volume / body's = {}",
+                total / want
+            );
+            assert!(p.len() > 500);
+        }
+    }
+    // the 2D assembly names a 3D scene for what it is
     let e = sppm::run::prepare(&scene(BLOCK, &[]).unwrap())
         .err()
         .unwrap()
         .to_string();
     says(&e, &["fcc", "3D scene", "prepare_solid"]);
     let concrete = format!("{BLOCK}\n[concrete]\nfc = 40.0e6\nGf = 100.0\n");
-    let e = sppm::run::solid::prepare_solid(&scene(&concrete, &[]).unwrap(), &|_| {})
-        .err()
-        .unwrap()
-        .to_string();
-    says(&e, &["concrete", "absent in 3D for now"]);
+    let mut p = sppm::run::solid::prepare_solid(&scene(&concrete, &[]).unwrap(), &|_| {}).unwrap();
+    let sim = sppm::run::build_simulation(&mut p);
+    assert!(sim.inelastic.is_some());
 }
 
 /// The acceptance: an elastic FCC block in uniaxial tension, its side faces free,

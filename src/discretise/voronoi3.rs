@@ -10,8 +10,9 @@
 
 use super::fcc::{cell_volume, SECOND, SLOTS};
 use super::{Particles, NONE};
-use crate::geometry::Shape3;
-use nalgebra::Vector3;
+use crate::geometry::{Shape2, Shape3};
+use nalgebra::{Vector2, Vector3};
+use rayon::prelude::*;
 use rstar::{primitives::GeomWithData, RTree};
 
 type P = Vector3<f64>;
@@ -132,10 +133,77 @@ impl ConvexPolyhedron {
     }
 }
 
-/// The Voronoi cell volumes of the particles of an FCC body clipped to `shape`; `None` when
-/// the shape has no convex polyhedral form ([`Shape3::planes`]).
-pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Option<Vec<f64>> {
-    let planes = shape.planes()?;
+/// The Voronoi cell volumes of the particles of an FCC body clipped to `shape`: exactly for
+/// the box (a convex polyhedron, [`Shape3::planes`]); for a prism and a cylinder, bodies with
+/// a section along an axis, by integrating the area of each cell's slices within the section
+/// along the axis ([`volume_in_section`]; the sum is within 1e-11 of the body's volume on
+/// the test bodies).
+pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
+    match shape {
+        Shape3::Box { .. } => polyhedral_volumes(p, shape),
+        Shape3::Extruded { section, thickness } => {
+            sectioned_volumes(p, section, *thickness, &|x: &P| *x)
+        }
+        Shape3::Cylinder {
+            base,
+            axis,
+            radius,
+            length,
+        } => {
+            // the cylinder's frame: two unit vectors normal to the axis, then the axis
+            let a = axis.normalize();
+            let helper = if a.x.abs() < 0.9 { P::x() } else { P::y() };
+            let e1 = helper.cross(&a).normalize();
+            let e2 = a.cross(&e1);
+            let disc = Shape2::Disc {
+                centre: Vector2::zeros(),
+                radius: *radius,
+            };
+            let base = *base;
+            sectioned_volumes(p, &disc, *length, &move |x: &P| {
+                let r = x - base;
+                P::new(r.dot(&e1), r.dot(&e2), r.dot(&a))
+            })
+        }
+    }
+}
+
+/// An R-tree of points, each with its index.
+fn tree_of(x: &[P]) -> RTree<GeomWithData<[f64; 3], usize>> {
+    RTree::bulk_load(
+        x.iter()
+            .enumerate()
+            .map(|(i, x)| GeomWithData::new([x.x, x.y, x.z], i))
+            .collect(),
+    )
+}
+
+/// The cell of particle i (positions x) within `bounds`: clipped by the bisector planes of
+/// the particles within `reach` (a point of the body lies within L0 of a particle, so only
+/// particles within 2·L0 and a margin bound a cell).
+fn clipped_cell(
+    x: &[P],
+    i: usize,
+    tree: &RTree<GeomWithData<[f64; 3], usize>>,
+    bounds: &ConvexPolyhedron,
+    reach: f64,
+) -> ConvexPolyhedron {
+    let xi = x[i];
+    let mut cell = bounds.clone();
+    for o in tree.locate_within_distance([xi.x, xi.y, xi.z], reach * reach) {
+        if o.data == i {
+            continue;
+        }
+        let d = x[o.data] - xi;
+        let mid = xi + d * 0.5;
+        cell.clip(&d, d.dot(&mid));
+    }
+    cell
+}
+
+/// The cells of a box-shaped body: the body's convex polyhedron clipped by the bisectors.
+fn polyhedral_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
+    let planes = shape.planes().expect("a convex polyhedral body");
     let (lo, hi) = shape.bounding_box();
     let pad = P::repeat(1e-3 * shape.size());
     let body = ConvexPolyhedron::from_planes(&planes, lo - pad, hi + pad);
@@ -147,36 +215,167 @@ pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Option<Ve
             .map(|(n, c)| c - n.dot(x))
             .fold(f64::INFINITY, f64::min)
     };
-    let tree = RTree::bulk_load(
-        p.x0.iter()
-            .enumerate()
-            .map(|(i, x)| GeomWithData::new([x.x, x.y, x.z], i))
-            .collect(),
+    let tree = tree_of(&p.x0);
+    (0..p.len())
+        .into_par_iter()
+        .map(|i| {
+            let x = p.x0[i];
+            let nearest_all = p.neighbours[i][..SECOND].iter().all(|&j| j != NONE);
+            if nearest_all && inside(&x) > l0 / 2f64.sqrt() * (1.0 + 1e-9) {
+                return full;
+            }
+            clipped_cell(&p.x0, i, &tree, &body, 2.5 * l0).volume()
+        })
+        .collect()
+}
+
+/// The cells of a body that is `section` (in the local x, y) through local z ∈ [0, length],
+/// `local` mapping a position to local coordinates: each cell clipped by the bisectors and
+/// the two end planes, then its volume within the section ([`volume_in_section`]). A
+/// particle with its 12 nearest neighbours farther than the cell's circumradius L0/√2 from
+/// the boundary keeps the full cell.
+fn sectioned_volumes(
+    p: &Particles<3, SLOTS>,
+    section: &Shape2,
+    length: f64,
+    local: &(dyn Fn(&P) -> P + Sync),
+) -> Vec<f64> {
+    let q: Vec<P> = p.x0.iter().map(local).collect();
+    let l0 = p.spacing;
+    let full = cell_volume(l0);
+    let rc = l0 / 2f64.sqrt() * (1.0 + 1e-9);
+    let (lo, hi) = section.bounding_box();
+    let pad = 1e-3 * section.size().max(length);
+    let bounds = ConvexPolyhedron::cuboid(
+        P::new(lo.x - pad, lo.y - pad, 0.0),
+        P::new(hi.x + pad, hi.y + pad, length),
     );
-    // a point of the body lies within L0 of a particle, so only particles within 2·L0 (and a
-    // margin) of particle i bound its cell
-    let reach = 2.5 * l0;
-    Some(
-        (0..p.len())
-            .map(|i| {
-                let x = p.x0[i];
-                let nearest_all = p.neighbours[i][..SECOND].iter().all(|&j| j != NONE);
-                if nearest_all && inside(&x) > l0 / 2f64.sqrt() * (1.0 + 1e-9) {
-                    return full;
-                }
-                let mut cell = body.clone();
-                for o in tree.locate_within_distance([x.x, x.y, x.z], reach * reach) {
-                    if o.data == i {
-                        continue;
-                    }
-                    let d = p.x0[o.data] - x;
-                    let mid = x + d * 0.5;
-                    cell.clip(&d, d.dot(&mid));
-                }
-                cell.volume()
-            })
-            .collect(),
-    )
+    let tree = tree_of(&q);
+    let tol = 1e-12 * full;
+    (0..p.len())
+        .into_par_iter()
+        .map(|i| {
+            let x = q[i];
+            let xy = Vector2::new(x.x, x.y);
+            let nearest_all = p.neighbours[i][..SECOND].iter().all(|&j| j != NONE);
+            let in_section = section.contains(&xy, 0.0);
+            let depth = if in_section {
+                section.boundary_distance(&xy)
+            } else {
+                0.0
+            };
+            if nearest_all && x.z > rc && x.z < length - rc && depth > rc {
+                return full;
+            }
+            let cell = clipped_cell(&q, i, &tree, &bounds, 2.5 * l0);
+            // a cell whose projection lies in the section keeps its clipped volume
+            let reach = cell
+                .faces
+                .iter()
+                .flatten()
+                .map(|v| (Vector2::new(v.x, v.y) - xy).norm())
+                .fold(0.0, f64::max);
+            if depth > reach * (1.0 + 1e-9) {
+                return cell.volume();
+            }
+            volume_in_section(&cell, section, tol)
+        })
+        .collect()
+}
+
+/// The polygon where the plane at height z cuts a convex polyhedron, projected on (x, y),
+/// counter-clockwise (empty where the plane misses it).
+pub fn slice(cell: &ConvexPolyhedron, z: f64) -> Vec<Vector2<f64>> {
+    let mut pts: Vec<Vector2<f64>> = Vec::new();
+    let mut scale: f64 = 0.0;
+    for f in &cell.faces {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            scale = scale.max(a.x.abs()).max(a.y.abs());
+            if a.z == z {
+                pts.push(Vector2::new(a.x, a.y));
+            } else if (a.z - z) * (b.z - z) < 0.0 {
+                let t = (z - a.z) / (b.z - a.z);
+                let q = a + (b - a) * t;
+                pts.push(Vector2::new(q.x, q.y));
+            }
+        }
+    }
+    if pts.len() < 3 {
+        return Vec::new();
+    }
+    let c = pts.iter().fold(Vector2::zeros(), |s, p| s + p) / pts.len() as f64;
+    pts.sort_by(|a, b| {
+        (a.y - c.y)
+            .atan2(a.x - c.x)
+            .total_cmp(&(b.y - c.y).atan2(b.x - c.x))
+    });
+    let tol = 1e-12 * scale.max(f64::MIN_POSITIVE);
+    pts.dedup_by(|a, b| (*a - *b).norm() <= tol);
+    while pts.len() > 1 && (pts[0] - pts[pts.len() - 1]).norm() <= tol {
+        pts.pop();
+    }
+    pts
+}
+
+/// The volume of a convex polyhedron within the prism `section` × ℝ: ∫ A(z) dz with A(z) the
+/// area of its slice within the section (`voronoi::area_in_body`, exact), integrated between
+/// consecutive heights of its vertices (where A changes form) by adaptive five-point
+/// Gauss–Legendre quadrature to the absolute tolerance `tol`.
+pub fn volume_in_section(cell: &ConvexPolyhedron, section: &Shape2, tol: f64) -> f64 {
+    let mut zs: Vec<f64> = cell.faces.iter().flatten().map(|v| v.z).collect();
+    zs.sort_by(f64::total_cmp);
+    let span = zs.last().copied().unwrap_or(0.0) - zs.first().copied().unwrap_or(0.0);
+    zs.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * span);
+    let area = |z: f64| {
+        let s = slice(cell, z);
+        if s.len() < 3 {
+            0.0
+        } else {
+            super::voronoi::area_in_body(&s, section)
+        }
+    };
+    let parts = (zs.len().max(2) - 1) as f64;
+    zs.windows(2)
+        .map(|w| {
+            let whole = gauss5(&area, w[0], w[1]);
+            adaptive(&area, w[0], w[1], whole, tol / parts, 40)
+        })
+        .sum()
+}
+
+/// Five-point Gauss–Legendre quadrature of f over [a, b] (exact for degree ≤ 9).
+fn gauss5(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    let s = (10.0f64 / 7.0).sqrt();
+    let x1 = (5.0 - 2.0 * s).sqrt() / 3.0;
+    let x2 = (5.0 + 2.0 * s).sqrt() / 3.0;
+    let r70 = 70.0f64.sqrt();
+    let (w0, w1, w2) = (
+        128.0 / 225.0,
+        (322.0 + 13.0 * r70) / 900.0,
+        (322.0 - 13.0 * r70) / 900.0,
+    );
+    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+    h * (w0 * f(m) + w1 * (f(m - h * x1) + f(m + h * x1)) + w2 * (f(m - h * x2) + f(m + h * x2)))
+}
+
+/// [`adaptive`] accepts no level before it has split each interval twice (the depth falls
+/// from 40): the halves of an interval with a kink inside (where a slice's corner crosses the
+/// section's outline) can agree with the whole by chance. Measured on the test bodies
+/// (`clipped_cells_sum_to_cylinders_and_prisms`), the volumes' sum missed the body's by up
+/// to 1.9e-9 accepting any level, 1.3e-9 after one split, 8e-12 after two (2.7 s for the
+/// eight bodies), 2e-13 after four (13 s).
+const MIN_SPLIT: u32 = 38;
+
+/// [`gauss5`] on halves of [a, b] until the halves agree with the whole to `tol`.
+fn adaptive(f: &dyn Fn(f64) -> f64, a: f64, b: f64, whole: f64, tol: f64, depth: u32) -> f64 {
+    let m = 0.5 * (a + b);
+    let (l, r) = (gauss5(f, a, m), gauss5(f, m, b));
+    if depth == 0 || (depth < MIN_SPLIT && (l + r - whole).abs() <= tol) {
+        l + r
+    } else {
+        adaptive(f, a, m, l, 0.5 * tol, depth - 1) + adaptive(f, m, b, r, 0.5 * tol, depth - 1)
+    }
 }
 
 #[cfg(test)]
@@ -251,11 +450,104 @@ mod tests {
                     offset: P::from(off) * l0,
                 }
                 .fill(&shape);
-                let v = fcc_clipped_volumes(&p, &shape).unwrap();
+                let v = fcc_clipped_volumes(&p, &shape);
                 let total: f64 = v.iter().sum();
                 assert_relative_eq!(total, shape.volume(), max_relative = 1e-9);
                 assert!(v.iter().all(|&x| x > 0.0 && x <= cell_volume(l0) * 2.5));
             }
         }
+    }
+
+    /// A cylinder (along z and along a tilted axis) and two prisms (the dog-bone, with arcs;
+    /// a notched beam, with a cutout): the clipped cells sum to the body's volume.
+    #[test]
+    fn clipped_cells_sum_to_cylinders_and_prisms() {
+        use crate::geometry::Cutout;
+        let l0 = 2e-3;
+        let dogbone = Shape2::DogBone { size: 0.02 };
+        let beam = Shape2::WithCutouts {
+            outer: Box::new(Shape2::Rectangle {
+                origin: Vector2::zeros(),
+                width: 0.035,
+                height: 0.012,
+            }),
+            cutouts: vec![Cutout::rectangle(
+                Vector2::new(0.0165, -0.001),
+                0.002,
+                0.005,
+                0.0,
+            )],
+        };
+        let shapes = [
+            Shape3::Cylinder {
+                base: P::new(0.001, -0.002, 0.0),
+                axis: P::z(),
+                radius: 0.009,
+                length: 0.013,
+            },
+            Shape3::Cylinder {
+                base: P::zeros(),
+                axis: P::new(1.0, 0.4, -0.3).normalize(),
+                radius: 0.007,
+                length: 0.016,
+            },
+            Shape3::Extruded {
+                section: dogbone,
+                thickness: 0.011,
+            },
+            Shape3::Extruded {
+                section: beam,
+                thickness: 0.01,
+            },
+        ];
+        for shape in &shapes {
+            for (rot, off) in [
+                ([0.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
+                ([30.0, 20.0, 10.0], [0.37, 0.61, 0.13]),
+            ] {
+                let p = FccLattice {
+                    spacing: l0,
+                    rotation_deg: rot,
+                    offset: P::from(off) * l0,
+                }
+                .fill(shape);
+                let v = fcc_clipped_volumes(&p, shape);
+                let total: f64 = v.iter().sum();
+                assert_relative_eq!(total, shape.volume(), max_relative = 1e-9);
+                assert!(v.iter().all(|&x| x > 0.0 && x <= cell_volume(l0) * 2.5));
+            }
+        }
+    }
+
+    /// The slice of a unit cube at any height is the unit square; of a corner tetrahedron, a
+    /// triangle whose area falls as (1 − z)²/2.
+    #[test]
+    fn slices_of_convex_polyhedra() {
+        let cube = ConvexPolyhedron::cuboid(P::zeros(), P::repeat(1.0));
+        let s = slice(&cube, 0.3);
+        assert_eq!(s.len(), 4);
+        assert_relative_eq!(crate::geometry::polygon_area(&s), 1.0, max_relative = 1e-14);
+        let mut tet = cube.clone();
+        tet.clip(&P::new(1.0, 1.0, 1.0), 1.0);
+        for z in [0.1, 0.5, 0.9] {
+            let s = slice(&tet, z);
+            assert_eq!(s.len(), 3);
+            let a = crate::geometry::polygon_area(&s);
+            assert_relative_eq!(a, (1.0 - z) * (1.0 - z) / 2.0, max_relative = 1e-12);
+        }
+        assert!(slice(&tet, 1.5).is_empty());
+        // the volume within a section that cuts the cube in half along x + y = 1
+        let half = Shape2::Polygon {
+            vertices: vec![
+                Vector2::new(-1.0, -1.0),
+                Vector2::new(2.0, -1.0),
+                Vector2::new(-1.0, 2.0),
+            ],
+        };
+        assert_relative_eq!(
+            volume_in_section(&cube, &half, 1e-14),
+            0.5,
+            max_relative = 1e-12
+        );
     }
 }

@@ -34,10 +34,9 @@ pub struct SolidBody {
 }
 
 /// The FCC body of a 3D scene with its volumes and micro-moduli. `discretisation.surface`:
-/// "voronoi_fit" (the default) clips each cell to the body (`discretise::voronoi3`) where
-/// the body is a convex polyhedron (a box) and fits the boundary particles' (a, b, c); on a
-/// cylinder or a prism the clipped cells are not available yet and the scene must say
-/// `surface = "lattice_fit"` (full cells, fitted boundary moduli) or `"lattice"`.
+/// "voronoi_fit" (the default) clips each cell to the body (`discretise::voronoi3`: box,
+/// cylinder, prism) and fits the boundary particles' (a, b, c); `"lattice_fit"` keeps full
+/// cells with fitted boundary moduli, `"lattice"` the source's full cells and bulk moduli.
 pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunError> {
     let d = &scene.discretisation;
     let m = &scene.material;
@@ -52,21 +51,8 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
         return Err(RunError::Scene(crate::scene::SceneError::Invalid {
             key: "discretisation.surface".into(),
             value: "\"voronoi\"".into(),
-            allowed:
-                "\"voronoi_fit\" (box bodies), \"lattice_fit\" or \"lattice\" for the FCC lattice"
-                    .into(),
+            allowed: "\"voronoi_fit\", \"lattice_fit\" or \"lattice\" for the FCC lattice".into(),
         }));
-    }
-    // refused before the fill: a body without clipped cells under the default treatment
-    let no_cells = || {
-        RunError::Scene(crate::scene::SceneError::Invalid {
-        key: "discretisation.surface".into(),
-        value: format!("\"voronoi_fit\" (the default) on body.shape = \"{}\"", scene.body.name()),
-        allowed: "\"lattice_fit\" (full cells, fitted boundary moduli) or \"lattice\" (the source) on a cylinder or a prism: their clipped 3D Voronoi cells are not available yet (a box has them)".into(),
-    })
-    };
-    if method == Surface::VoronoiFit && solid.planes().is_none() {
-        return Err(no_cells());
     }
     let [ox, oy, oz] = d.offset3();
     let lattice = FccLattice {
@@ -82,8 +68,7 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
             p.len()
         )));
     }
-    let report =
-        surface_treatment(&mut p, &solid, method, m.youngs_modulus(), m.nu).ok_or_else(no_cells)?;
+    let report = surface_treatment(&mut p, &solid, method, m.youngs_modulus(), m.nu);
     Ok((p, report))
 }
 
@@ -91,17 +76,16 @@ pub fn fcc_body(scene: &Scene) -> Result<(Particles<3, SLOTS>, SolidBody), RunEr
 /// "voronoi" is not offered in 3D) into its volumes and micro-moduli for (E, ν):
 /// `voronoi_fit` clips every cell to the body and fits the boundary particles
 /// ([`assign_moduli`]), `lattice_fit` fits them in full cells, `lattice` gives every particle
-/// the full cell and the bulk constants. `None` when `voronoi_fit` meets a body without
-/// clipped cells (not a convex polyhedron).
+/// the full cell and the bulk constants.
 pub fn surface_treatment(
     p: &mut Particles<3, SLOTS>,
     solid: &Shape3,
     method: Surface,
     e: f64,
     nu: f64,
-) -> Option<SolidBody> {
+) -> SolidBody {
     if method == Surface::VoronoiFit {
-        p.volume = voronoi3::fcc_clipped_volumes(p, solid)?;
+        p.volume = voronoi3::fcc_clipped_volumes(p, solid);
     }
     let moduli = if method == Surface::Lattice {
         let n = p.len();
@@ -114,12 +98,12 @@ pub fn surface_treatment(
     } else {
         assign_moduli(p, e, nu)
     };
-    Some(SolidBody {
+    SolidBody {
         method: method.name(),
         body_volume: solid.volume(),
         particle_volume: p.volume.iter().sum(),
         moduli,
-    })
+    }
 }
 
 /// The assembled elastic model of a 3D scene (FCC, 18 slots): body, groups, supports,

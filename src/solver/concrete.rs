@@ -1225,7 +1225,11 @@ mod tests {
             origin: nalgebra::Vector3::zeros(),
             size: nalgebra::Vector3::new(0.013, 0.011, 0.015),
         });
-        assert!(!fcc.len().is_multiple_of(LANES) && fcc.len() > 200, "{}", fcc.len());
+        assert!(
+            !fcc.len().is_multiple_of(LANES) && fcc.len() > 200,
+            "{}",
+            fcc.len()
+        );
         assert!(fcc.weighted_dilatation);
         check_pass_state::<3, 18, false>(&fcc, false);
         check_pass_state::<3, 18, true>(&fcc, false);
