@@ -90,7 +90,7 @@ pub fn bytes_per_particle(kernel: KernelSet, dim: usize) -> usize {
     let base = crate::discretise::bytes_per_particle(dim, crate::discretise::slots(dim));
     match kernel {
         KernelSet::Elastic => base,
-        _ => base + 60 * 8 + 6 * 8,
+        _ => base + crate::solver::concrete::bytes_per_particle(dim, crate::discretise::slots(dim)),
     }
 }
 

@@ -1,9 +1,11 @@
 //! The maps of a 3D run draw a section, not every particle: a person reads a crack or a
 //! stress field on a plane at a glance, and a map of 10⁶ particles stays a small file. The
-//! section is the mid-plane of the body's bounding box normal to its shortest extent (ties:
-//! z before y before x): the x–z plane of a prism loaded along z, the x–y plane of a
-//! dog-bone prism or a beam. Its particles are those within half a spacing of the plane;
-//! the title names the plane, the axes their coordinates.
+//! section is the mid-plane normal to z for a body with a section along z (a prism: the
+//! dog-bone, a beam; a cylinder along z: the split cylinder's disc, its split through the
+//! loaded diameter), else the mid-plane of the body's bounding box normal to its shortest
+//! extent (ties: z before y before x; the x–z plane of a box loaded along z). Its particles
+//! are those within half a spacing of the plane; the title names the plane, the axes their
+//! coordinates.
 
 use crate::run::Outcome;
 
@@ -21,11 +23,16 @@ pub fn section_view(o: &Outcome) -> Outcome {
         }
     }
     let extent = |d: usize| hi[d] - lo[d];
-    // the normal: the shortest extent, ties to z, then y, then x
-    let normal = [2, 1, 0]
-        .into_iter()
-        .min_by(|&a, &b| extent(a).total_cmp(&extent(b)).then(b.cmp(&a)))
-        .expect("three axes");
+    // the normal: z for a body with a section along z (a prism, a cylinder along z: its
+    // section as in 2D), else the shortest extent, ties to z, then y, then x
+    let normal = if o.scene.section_along_z().is_some() {
+        2
+    } else {
+        [2, 1, 0]
+            .into_iter()
+            .min_by(|&a, &b| extent(a).total_cmp(&extent(b)).then(b.cmp(&a)))
+            .expect("three axes")
+    };
     let (u, v) = match normal {
         2 => (0, 1),
         1 => (0, 2),

@@ -84,7 +84,7 @@ pub fn estimated_particles(scene: &Scene) -> f64 {
     scene.shape().area() / (0.5 * 3f64.sqrt() * l0 * l0)
 }
 
-/// Estimated bytes a run allocates (2D or 3D).
+/// Estimated bytes a run allocates (2D or 3D; with `[concrete]`, the damage kernel's too).
 pub fn estimated_memory(scene: &Scene) -> f64 {
     let dim = scene.discretisation.dim();
     let slots = if dim == 3 {
@@ -92,7 +92,12 @@ pub fn estimated_memory(scene: &Scene) -> f64 {
     } else {
         slots_of(scene)
     };
-    estimated_particles(scene) * bytes_per_particle(dim, slots) as f64
+    let damage = if scene.concrete.is_some() {
+        crate::solver::concrete::bytes_per_particle(dim, slots)
+    } else {
+        0
+    };
+    estimated_particles(scene) * (bytes_per_particle(dim, slots) + damage) as f64
 }
 
 /// Refuse a scene whose body would not fit this machine's memory (80% of what is available)

@@ -543,7 +543,8 @@ pub struct ConcreteSpec {
     /// COD_eq = crack_band·L0·ε_I. (4.13) writes 2; the defaults are measured. Lattices 2.8:
     /// with 2, a block in uniaxial tension dissipates 1.32 and 1.47 × G_f·A at L0 = 10 and
     /// 5 mm; with 2.8, 0.975 and 1.029 × G_f·A (benchmarks/RESULTS.md, "Concrete in 2D").
-    /// Random particles 3.2 (docs/sppm.md, "Crack band"). Always set after [`Scene::resolve`].
+    /// Random particles 3.2 (docs/sppm.md, "Crack band"); the FCC lattice 3.3
+    /// (benchmarks/RESULTS.md, "Concrete in 3D"). Always set after [`Scene::resolve`].
     #[serde(default)]
     pub crack_band: Option<f64>,
     #[serde(default = "default_initiation")]

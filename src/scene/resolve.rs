@@ -14,6 +14,10 @@ pub const LATTICE_CRACK_BAND: f64 = 2.8;
 /// (measured: docs/sppm.md, "Crack band").
 pub const RANDOM_CRACK_BAND: f64 = 3.2;
 
+/// The crack band of the FCC lattice in units of L0 (measured: benchmarks/RESULTS.md,
+/// "Concrete in 3D": a tension prism's dissipated energy against G_f·A at two spacings).
+pub const FCC_CRACK_BAND: f64 = 3.3;
+
 fn positive_opt(key: &str, v: Option<f64>) -> Result<(), SceneError> {
     match v {
         Some(x) if !(x.is_finite() && x > 0.0) => {
@@ -189,7 +193,12 @@ impl Scene {
         // The crack opening of a particle at initiation, 2·L0·f't/E (4.13): the softening law
         // needs room beyond it.
         let l0 = self.discretisation.spacing;
-        let (default, source) = if self.discretisation.is_random() {
+        let (default, source) = if self.discretisation.dim() == 3 {
+            (
+                FCC_CRACK_BAND,
+                "the FCC lattice's default (benchmarks/RESULTS.md, \"Concrete in 3D\")",
+            )
+        } else if self.discretisation.is_random() {
             (
                 RANDOM_CRACK_BAND,
                 "random particles' default (docs/sppm.md, \"Crack band\")",

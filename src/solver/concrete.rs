@@ -61,6 +61,15 @@ use rayon::prelude::*;
 #[cfg(target_arch = "x86_64")]
 mod avx;
 
+/// Bytes per particle the damage kernel ([`Concrete`]) allocates beside the elastic run's
+/// (`discretise::bytes_per_particle`), counted field by field: the strain projector
+/// (D(D+1)/2 × K f64), the committed and trial plastic stretch states (2·K f64), the slot
+/// cache (4·K f64), the reverse slots (K u8), the committed and trial law states (2 × 32 B)
+/// and the length scale (f64). D = 2, K = 6: 510 B; D = 3, K = 18 (FCC): 1818 B.
+pub const fn bytes_per_particle(d: usize, k: usize) -> usize {
+    (d * (d + 1) / 2 + 2 + FIELDS) * k * 8 + k + 2 * std::mem::size_of::<ParticleDamage>() + 8
+}
+
 /// Damage and plasticity of a run: the law, the per-particle geometry the kernel needs, and
 /// the committed and trial state.
 #[derive(Clone, Debug)]
@@ -1197,6 +1206,28 @@ mod tests {
         };
         let (rnd, _, _) = random::fill::<{ random::SLOTS_2D }>(&shape, &recipe).unwrap();
         (hex, rnd)
+    }
+
+    /// The memory estimate counts what [`Concrete::new`] allocates per particle.
+    #[test]
+    fn damage_kernel_bytes_per_particle_count_its_arrays() {
+        fn count<const D: usize, const K: usize>() -> usize
+        where
+            Dim<D>: Dimension<D>,
+        {
+            std::mem::size_of::<<Dim<D> as Dimension<D>>::StrainFit<K>>()
+                + 2 * std::mem::size_of::<[f64; K]>()
+                + slot_cache_len(4096, K) * 8 / 4096
+                + std::mem::size_of::<[u8; K]>()
+                + 2 * std::mem::size_of::<ParticleDamage>()
+                + std::mem::size_of::<f64>()
+        }
+        assert_eq!(bytes_per_particle(2, 6), count::<2, 6>());
+        assert_eq!(bytes_per_particle(3, 18), count::<3, 18>());
+        assert_eq!(
+            (bytes_per_particle(2, 6), bytes_per_particle(3, 18)),
+            (510, 1818)
+        );
     }
 
     #[test]
