@@ -321,3 +321,38 @@ fn tension_prism_reaches_ft_dissipates_gf_and_cracks_across() {
         );
     }
 }
+
+/// The interaction criterion in 3D on the FCC lattice (clipped cells, fitted boundary
+/// moduli, second-neighbour modulus): under the homogeneous stress σ = diag(σ1, 0, σ3) with
+/// σ1 = s·f't/2 and σ3 = −s·f'c/2, σ1/f't − σ3/f'c = s, so every particle initiates at s = 1
+/// and none below (to the finite stretches' second order), and the recorded initiation strain
+/// is the largest principal strain ε1 = (σ1 − ν·σ3)/E.
+#[test]
+fn interaction_initiation_on_the_fcc_lattice() {
+    let (p, m) = fcc_block();
+    let mut l = law();
+    l.initiation = Initiation::Interaction;
+    for (s, expect) in [(0.98, false), (1.02, true)] {
+        let (s1, s3) = (0.5 * s * l.ft, -0.5 * s * l.fc);
+        let e1 = (s1 - l.nu * s3) / l.e;
+        let e2 = -l.nu * (s1 + s3) / l.e;
+        let e3 = (s3 - l.nu * s1) / l.e;
+        let x: Vec<_> =
+            p.x0.iter()
+                .map(|x| Vector3::new(x.x * (1.0 + e1), x.y * (1.0 + e2), x.z * (1.0 + e3)))
+                .collect();
+        let mut c: Concrete<3, 18> = Concrete::new(TwoSpring::new(l, None), &p);
+        concrete::internal_forces(&m, &mut c, &x);
+        c.commit();
+        for (i, d) in c.damage().iter().enumerate() {
+            assert_eq!(d.initiated, expect, "particle {i} at s = {s}");
+            if expect {
+                assert!(
+                    (d.eps_init - e1).abs() <= 5e-3 * e1,
+                    "particle {i}: ε_init {} against {e1}",
+                    d.eps_init
+                );
+            }
+        }
+    }
+}

@@ -209,6 +209,24 @@ fn cylinders_and_prisms_carry_their_volume_and_3d_concrete_prepares() {
         .unwrap()
         .to_string();
     says(&e, &["fcc", "3D scene", "prepare_solid"]);
+    // a strip on a body without a section along z selects nothing: named, with what is allowed
+    let strip = format!(
+        "{BLOCK}\n[[groups]]\nname = \"platen\"\nselect = {{ by = \"strip\", edge = \"top\", width = 0.004 }}\nfix = [\"x\"]\n"
+    );
+    let e = sppm::run::solid::prepare_solid(&scene(&strip, &[]).unwrap(), &|_| {})
+        .err()
+        .unwrap()
+        .to_string();
+    says(
+        &e,
+        &[
+            "groups.platen.select",
+            "strip",
+            "\"box\"",
+            "has none",
+            "by = \"edge\"",
+        ],
+    );
     let concrete = format!("{BLOCK}\n[concrete]\nfc = 40.0e6\nGf = 100.0\n");
     let mut p = sppm::run::solid::prepare_solid(&scene(&concrete, &[]).unwrap(), &|_| {}).unwrap();
     let sim = sppm::run::build_simulation(&mut p);

@@ -40,30 +40,49 @@ pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
 pub const PARTICLE_COLUMNS: [&str; 7] =
     ["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];
 
+/// Columns of particles.csv of a 3D run: the position, displacement and stress in 3D.
+pub const PARTICLE_COLUMNS_3D: [&str; 12] = [
+    "x_m", "y_m", "z_m", "ux_m", "uy_m", "uz_m", "sxx_Pa", "syy_Pa", "szz_Pa", "syz_Pa", "sxz_Pa",
+    "sxy_Pa",
+];
+
 /// Columns particles.csv adds for scenes with damage: w_t, w_c and yielded (0 or 1).
 pub const DAMAGE_COLUMNS: [&str; 3] = ["tensile_damage", "compressive_damage", "yielded"];
 
 /// particles.csv: one row per particle at the end of the run: reference position, displacement,
-/// recovered stress (`run::stress_recovery`) and, with damage, w_t, w_c and whether it yielded.
+/// (in 3D with z, u_z and the six stress components) recovered stress (`run::stress_recovery`) and, with damage, w_t, w_c and whether it yielded.
 pub fn write_particles(o: &crate::run::Outcome, path: &Path) -> anyhow::Result<()> {
     let mut w = ::csv::Writer::from_path(path)
         .with_context(|| format!("cannot write {}", path.display()))?;
-    let mut head = PARTICLE_COLUMNS.to_vec();
+    let mut head = if o.dim == 3 {
+        PARTICLE_COLUMNS_3D.to_vec()
+    } else {
+        PARTICLE_COLUMNS.to_vec()
+    };
     if o.damage.is_some() {
         head.extend(DAMAGE_COLUMNS);
     }
     w.write_record(&head)?;
     for i in 0..o.x0.len() {
         let (x, u, s) = (o.x0[i], o.displacement[i], o.stress[i]);
-        let mut row = vec![
-            format!("{:e}", x[0]),
-            format!("{:e}", x[1]),
-            format!("{:e}", u[0]),
-            format!("{:e}", u[1]),
-            format!("{:e}", s[0]),
-            format!("{:e}", s[1]),
-            format!("{:e}", s[5]),
-        ];
+        let mut row: Vec<String> = if o.dim == 3 {
+            // stress in Voigt order [xx, yy, zz, yz, xz, xy]
+            x.iter()
+                .chain(&u)
+                .chain(&s)
+                .map(|v| format!("{v:e}"))
+                .collect()
+        } else {
+            vec![
+                format!("{:e}", x[0]),
+                format!("{:e}", x[1]),
+                format!("{:e}", u[0]),
+                format!("{:e}", u[1]),
+                format!("{:e}", s[0]),
+                format!("{:e}", s[1]),
+                format!("{:e}", s[5]),
+            ]
+        };
         if let Some(d) = &o.damage {
             row.push(format!("{}", d[i].wt));
             row.push(format!("{}", d[i].wc));

@@ -1254,7 +1254,7 @@ mod tests {
         }
         .fill(&crate::geometry::solid::Shape3::Box {
             origin: nalgebra::Vector3::zeros(),
-            size: nalgebra::Vector3::new(0.013, 0.011, 0.015),
+            size: nalgebra::Vector3::new(0.0133, 0.011, 0.015),
         });
         assert!(
             !fcc.len().is_multiple_of(LANES) && fcc.len() > 200,
