@@ -176,6 +176,30 @@ pub fn bench(
     }
 }
 
+/// The bench's damage model for `kernel` (Table 1 concrete of 002; `None` for the elastic
+/// kernel), checked to choose that kernel.
+fn damage_model<const D: usize, const K: usize>(
+    p: &crate::discretise::Particles<D, K>,
+    kernel: KernelSet,
+) -> anyhow::Result<Option<crate::solver::concrete::Concrete<D, K>>>
+where
+    crate::model::dimension::Dim<D>: crate::model::dimension::Dimension<D>,
+{
+    let model = (kernel != KernelSet::Elastic).then(|| {
+        let law = crate::model::damage::ConcreteLaw::table1(kernel == KernelSet::Full);
+        crate::solver::concrete::Concrete::<D, K>::new(
+            crate::model::two_spring::TwoSpring::new(law, None),
+            p,
+        )
+    });
+    let chosen = model.as_ref().map_or(KernelSet::Elastic, |c| c.kernel());
+    anyhow::ensure!(
+        chosen == kernel,
+        "the law chose the {chosen:?} kernel, not {kernel:?}"
+    );
+    Ok(model)
+}
+
 /// Time the steps of a filled body with its micro-moduli.
 fn time_steps<const K: usize>(
     p: crate::discretise::Particles<2, K>,
@@ -201,18 +225,7 @@ fn time_steps<const K: usize>(
     for (x, x0) in st.x.iter_mut().zip(&p.x0) {
         *x = x0 * (1.0 + strain);
     }
-    let mut model = concrete.then(|| {
-        let law = crate::model::damage::ConcreteLaw::table1(kernel == KernelSet::Full);
-        crate::solver::concrete::Concrete::<2, K>::new(
-            crate::model::two_spring::TwoSpring::new(law, None),
-            &p,
-        )
-    });
-    let chosen = model.as_ref().map_or(KernelSet::Elastic, |c| c.kernel());
-    anyhow::ensure!(
-        chosen == kernel,
-        "the law chose the {chosen:?} kernel, not {kernel:?}"
-    );
+    let mut model = damage_model(&p, kernel)?;
     let csr = match layout {
         Layout::Csr => Some(Csr::from_slots(&p).map_err(|e| anyhow::anyhow!("CSR bonds: {e}"))?),
         Layout::Slots => None,
@@ -340,18 +353,7 @@ pub fn bench_fcc(
     for (x, x0) in st.x.iter_mut().zip(&p.x0) {
         *x = x0 * (1.0 + strain);
     }
-    let mut model = concrete.then(|| {
-        let law = crate::model::damage::ConcreteLaw::table1(kernel == KernelSet::Full);
-        crate::solver::concrete::Concrete::<3, 18>::new(
-            crate::model::two_spring::TwoSpring::new(law, None),
-            &p,
-        )
-    });
-    let chosen = model.as_ref().map_or(KernelSet::Elastic, |c| c.kernel());
-    anyhow::ensure!(
-        chosen == kernel,
-        "the law chose the {chosen:?} kernel, not {kernel:?}"
-    );
+    let mut model = damage_model(&p, kernel)?;
     drop(p);
     let seconds = timed(&pool, steps, || {
         match model.as_mut() {
