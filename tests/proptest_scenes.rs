@@ -490,8 +490,12 @@ fn shipped() -> Vec<(String, Value)> {
             .entry("loading")
             .or_insert(Value::Table(Default::default()))
             .as_table_mut()
-            .unwrap()
-            .insert("end_periods".into(), Value::Float(2.0));
+            .map(|t| {
+                // a loading time in periods, in place of one in seconds
+                t.remove("end_s");
+                t.insert("end_periods".into(), Value::Float(2.0))
+            })
+            .unwrap();
         let coarse = toml::to_string(&v).unwrap();
         Scene::from_toml_str(&coarse, &[]).unwrap();
         out.push((f.display().to_string(), v));

@@ -175,11 +175,19 @@ fn unbond_flat_particles(
     neighbours: &mut [[u32; SLOTS]],
     reverse: &[[u8; SLOTS]],
 ) {
-    use crate::model::dimension::{Dim, Dimension};
     let spans = |i: usize, nb: &[[u32; SLOTS]]| {
         let mut m = nalgebra::Matrix6::zeros();
         for &j in nb[i].iter().filter(|&&j| j != NONE) {
-            let p = Dim::<3>::projector(&(x0[j as usize] - x0[i]).normalize());
+            // the bond's strain projector n⊗n in Voigt order (as `model::dimension`'s)
+            let n = (x0[j as usize] - x0[i]).normalize();
+            let p = nalgebra::Vector6::new(
+                n.x * n.x,
+                n.y * n.y,
+                n.z * n.z,
+                n.y * n.z,
+                n.x * n.z,
+                n.x * n.y,
+            );
             m += p * p.transpose();
         }
         // the smallest eigenvalue of Σ p·pᵀ (p the bond's strain projector): 0 where the
