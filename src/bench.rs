@@ -84,8 +84,7 @@ impl Layout {
 
 /// Bytes per particle a benchmark of `kernel` in `dim` dimensions allocates: the run's arrays
 /// ([`crate::discretise::bytes_per_particle`], with the lattice's slots) and, with damage,
-/// the concrete state (strain fit, committed and trial damage and plastic stretch: about 60
-/// f64 per particle).
+/// the damage kernel's ([`crate::solver::concrete::bytes_per_particle`]).
 pub fn bytes_per_particle(kernel: KernelSet, dim: usize) -> usize {
     let base = crate::discretise::bytes_per_particle(dim, crate::discretise::slots(dim));
     match kernel {
@@ -176,6 +175,33 @@ pub fn bench(
     }
 }
 
+/// The bench's mechanics of a body (ρ = 2400 kg/m³, bond and particle dampers with ξ = 0.2
+/// as in the shipped scenes) and its state under a small homogeneous strain so that every
+/// bond works: 1e-4 for the elastic kernel, 0.9e-4 for a damage kernel (see [`bench`] and
+/// [`bench_fcc`] for what it makes the particles do).
+fn strained_model<const D: usize, const K: usize>(
+    p: &crate::discretise::Particles<D, K>,
+    kernel: KernelSet,
+) -> (Mechanics<D, K>, State<D>) {
+    let n = p.len();
+    let mut mech = Mechanics::new(p, &vec![2400.0; n]);
+    let omega = crate::material::particle_frequency(30e9, 0.2, 2400.0, p.spacing);
+    for i in 0..n {
+        mech.c_in[i] = 2.0 * mech.mass[i] * 0.2 * omega;
+        mech.c_ex[i] = 2.0 * mech.mass[i] * 0.2 * 1e3;
+    }
+    let strain = if kernel == KernelSet::Elastic {
+        1e-4
+    } else {
+        0.9e-4
+    };
+    let mut st = State::at_rest(&p.x0);
+    for (x, x0) in st.x.iter_mut().zip(&p.x0) {
+        *x = x0 * (1.0 + strain);
+    }
+    (mech, st)
+}
+
 /// The bench's damage model for `kernel` (Table 1 concrete of 002; `None` for the elastic
 /// kernel), checked to choose that kernel.
 fn damage_model<const D: usize, const K: usize>(
@@ -209,22 +235,9 @@ fn time_steps<const K: usize>(
     layout: Layout,
     setup: Option<Setup>,
 ) -> anyhow::Result<BenchResult> {
-    let concrete = kernel != KernelSet::Elastic;
-    let l0 = p.spacing;
     let n = p.len();
-    let mut mech = Mechanics::new(&p, &vec![2400.0; n]);
-    let omega = crate::material::particle_frequency(30e9, 0.2, 2400.0, l0);
-    for i in 0..n {
-        mech.c_in[i] = 2.0 * mech.mass[i] * 0.2 * omega;
-        mech.c_ex[i] = 2.0 * mech.mass[i] * 0.2 * 1e3;
-    }
+    let (mech, mut st) = strained_model(&p, kernel);
     let dt = 0.9 * crate::solver::time_step::stable_step(&mech, &p.x0).dt_stable;
-    let mut st = State::at_rest(&p.x0);
-    // a small homogeneous strain so that every bond works
-    let strain = if concrete { 0.9e-4 } else { 1e-4 };
-    for (x, x0) in st.x.iter_mut().zip(&p.x0) {
-        *x = x0 * (1.0 + strain);
-    }
     let mut model = damage_model(&p, kernel)?;
     let csr = match layout {
         Layout::Csr => Some(Csr::from_slots(&p).map_err(|e| anyhow::anyhow!("CSR bonds: {e}"))?),
@@ -339,20 +352,9 @@ pub fn bench_fcc(
         .build()?;
     let p = fcc_block(fcc_cells(particles), l0);
     let n = p.len();
-    let mut mech = Mechanics::new(&p, &vec![2400.0; n]);
+    let (mech, mut st) = strained_model(&p, kernel);
     assert!(mech.second.is_some());
-    let omega = crate::material::particle_frequency(30e9, 0.2, 2400.0, l0);
-    for i in 0..n {
-        mech.c_in[i] = 2.0 * mech.mass[i] * 0.2 * omega;
-        mech.c_ex[i] = 2.0 * mech.mass[i] * 0.2 * 1e3;
-    }
     let dt = 0.9 * pool.install(|| crate::solver::time_step::stable_step(&mech, &p.x0).dt_stable);
-    let concrete = kernel != KernelSet::Elastic;
-    let mut st = State::at_rest(&p.x0);
-    let strain = if concrete { 0.9e-4 } else { 1e-4 };
-    for (x, x0) in st.x.iter_mut().zip(&p.x0) {
-        *x = x0 * (1.0 + strain);
-    }
     let mut model = damage_model(&p, kernel)?;
     drop(p);
     let seconds = timed(&pool, steps, || {

@@ -213,10 +213,7 @@ fn cylinders_and_prisms_carry_their_volume_and_3d_concrete_prepares() {
     let strip = format!(
         "{BLOCK}\n[[groups]]\nname = \"platen\"\nselect = {{ by = \"strip\", edge = \"top\", width = 0.004 }}\nfix = [\"x\"]\n"
     );
-    let e = sppm::run::solid::prepare_solid(&scene(&strip, &[]).unwrap(), &|_| {})
-        .err()
-        .unwrap()
-        .to_string();
+    let e = error_of(&strip, &[]);
     says(
         &e,
         &[

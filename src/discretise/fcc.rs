@@ -8,6 +8,7 @@
 //! side √2·L0 with a site at each corner and face centre).
 
 use super::{drop_isolated, Particles, NONE};
+use crate::geometry::solid::dyad_voigt;
 use crate::geometry::Shape3;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -178,16 +179,7 @@ fn unbond_flat_particles(
     let spans = |i: usize, nb: &[[u32; SLOTS]]| {
         let mut m = nalgebra::Matrix6::zeros();
         for &j in nb[i].iter().filter(|&&j| j != NONE) {
-            // the bond's strain projector n⊗n in Voigt order (as `model::dimension`'s)
-            let n = (x0[j as usize] - x0[i]).normalize();
-            let p = nalgebra::Vector6::new(
-                n.x * n.x,
-                n.y * n.y,
-                n.z * n.z,
-                n.y * n.z,
-                n.x * n.z,
-                n.x * n.y,
-            );
+            let p = dyad_voigt(&(x0[j as usize] - x0[i]).normalize());
             m += p * p.transpose();
         }
         // the smallest eigenvalue of Σ p·pᵀ (p the bond's strain projector): 0 where the

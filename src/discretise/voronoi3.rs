@@ -10,6 +10,7 @@
 
 use super::fcc::{cell_volume, SECOND, SLOTS};
 use super::{Particles, NONE};
+use crate::geometry::solid::Sweep;
 use crate::geometry::{Shape2, Shape3};
 use nalgebra::{Vector2, Vector3};
 use rayon::prelude::*;
@@ -139,32 +140,9 @@ impl ConvexPolyhedron {
 /// along the axis ([`volume_in_section`]; the sum is within 1e-11 of the body's volume on
 /// the test bodies).
 pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
-    match shape {
-        Shape3::Box { .. } => polyhedral_volumes(p, shape),
-        Shape3::Extruded { section, thickness } => {
-            sectioned_volumes(p, section, *thickness, &|x: &P| *x)
-        }
-        Shape3::Cylinder {
-            base,
-            axis,
-            radius,
-            length,
-        } => {
-            // the cylinder's frame: two unit vectors normal to the axis, then the axis
-            let a = axis.normalize();
-            let helper = if a.x.abs() < 0.9 { P::x() } else { P::y() };
-            let e1 = helper.cross(&a).normalize();
-            let e2 = a.cross(&e1);
-            let disc = Shape2::Disc {
-                centre: Vector2::zeros(),
-                radius: *radius,
-            };
-            let base = *base;
-            sectioned_volumes(p, &disc, *length, &move |x: &P| {
-                let r = x - base;
-                P::new(r.dot(&e1), r.dot(&e2), r.dot(&a))
-            })
-        }
+    match shape.sweep() {
+        Some(sweep) => sectioned_volumes(p, &sweep),
+        None => polyhedral_volumes(p, shape),
     }
 }
 
@@ -243,18 +221,14 @@ fn polyhedral_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
         .collect()
 }
 
-/// The cells of a body that is `section` (in the local x, y) through local z ∈ [0, length],
-/// `local` mapping a position to local coordinates: each cell clipped by the bisectors and
-/// the two end planes, then its volume within the section ([`volume_in_section`]). A
-/// particle with its 12 nearest neighbours farther than the cell's circumradius L0/√2 from
-/// the boundary keeps the full cell.
-fn sectioned_volumes(
-    p: &Particles<3, SLOTS>,
-    section: &Shape2,
-    length: f64,
-    local: &(dyn Fn(&P) -> P + Sync),
-) -> Vec<f64> {
-    let q: Vec<P> = p.x0.iter().map(local).collect();
+/// The cells of a swept body (a prism, a cylinder), in its local coordinates (the section
+/// in x, y through z ∈ [0, length]): each cell clipped by the bisectors and the two end
+/// planes, then its volume within the section ([`volume_in_section`]). A particle with its
+/// 12 nearest neighbours farther than the cell's circumradius L0/√2 from the boundary keeps
+/// the full cell.
+fn sectioned_volumes(p: &Particles<3, SLOTS>, sweep: &Sweep) -> Vec<f64> {
+    let (section, length) = (&sweep.section, sweep.length);
+    let q: Vec<P> = p.x0.iter().map(|x| sweep.local(x)).collect();
     let l0 = p.spacing;
     let full = cell_volume(l0);
     let rc = l0 / 2f64.sqrt() * (1.0 + 1e-9);
@@ -283,13 +257,13 @@ fn sectioned_volumes(
             }
             let cell = clipped_cell(&q, i, &tree, &bounds, 2.5 * l0);
             // a cell whose projection lies in the section keeps its clipped volume
-            let reach = cell
+            let radius_xy = cell
                 .faces
                 .iter()
                 .flatten()
                 .map(|v| (Vector2::new(v.x, v.y) - xy).norm())
                 .fold(0.0, f64::max);
-            if depth > reach * (1.0 + 1e-9) {
+            if depth > radius_xy * (1.0 + 1e-9) {
                 return cell.volume();
             }
             volume_in_section(&cell, section, tol)

@@ -6,6 +6,21 @@
 use super::Shape2;
 use nalgebra::{Vector2, Vector3};
 
+/// The dyad n⊗n of a direction in Voigt order [xx, yy, zz, yz, xz, xy]: a bond's strain
+/// projector (its stretch under a small strain ε is p·ε with engineering shears), shared by
+/// the strain fit (`model::dimension`) and the FCC fill's test of which particles' bonds
+/// determine a strain (`discretise::fcc`).
+pub fn dyad_voigt(n: &Vector3<f64>) -> nalgebra::Vector6<f64> {
+    nalgebra::Vector6::new(
+        n.x * n.x,
+        n.y * n.y,
+        n.z * n.z,
+        n.y * n.z,
+        n.x * n.z,
+        n.x * n.y,
+    )
+}
+
 /// A 3D specimen shape.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape3 {
@@ -23,6 +38,26 @@ pub enum Shape3 {
     },
     /// A 2D section (x, y) extruded through z ∈ [0, thickness].
     Extruded { section: Shape2, thickness: f64 },
+}
+
+/// A body that is a 2D section swept along an axis (a prism, a cylinder): `section` in the
+/// local (u, v) plane through local w ∈ [0, length]; [`Sweep::local`] maps a position to
+/// (u, v, w).
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    pub section: Shape2,
+    pub length: f64,
+    origin: Vector3<f64>,
+    /// Rows: the local u, v and w axes (w the sweep's axis).
+    axes: nalgebra::Matrix3<f64>,
+}
+
+impl Sweep {
+    /// Local coordinates (u, v, w) of `x`.
+    #[inline]
+    pub fn local(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        self.axes * (x - self.origin)
+    }
 }
 
 impl Shape3 {
@@ -109,6 +144,49 @@ impl Shape3 {
             Shape3::Extruded { section, .. } => {
                 let (pa, pb) = (Vector2::new(a.x, a.y), Vector2::new(b.x, b.y));
                 (pa - pb).norm() <= tol || section.segment_in_body(&pa, &pb, tol, parts)
+            }
+        }
+    }
+
+    /// The body as a section swept along an axis: a prism's section along z, a cylinder's
+    /// disc along its axis (u, v completing the axis to a right-handed frame); `None` for
+    /// the box.
+    pub fn sweep(&self) -> Option<Sweep> {
+        match self {
+            Shape3::Box { .. } => None,
+            Shape3::Extruded { section, thickness } => Some(Sweep {
+                section: section.clone(),
+                length: *thickness,
+                origin: Vector3::zeros(),
+                axes: nalgebra::Matrix3::identity(),
+            }),
+            Shape3::Cylinder {
+                base,
+                axis,
+                radius,
+                length,
+            } => {
+                let w = axis.normalize();
+                let helper = if w.x.abs() < 0.9 {
+                    Vector3::x()
+                } else {
+                    Vector3::y()
+                };
+                let u = helper.cross(&w).normalize();
+                let v = w.cross(&u);
+                Some(Sweep {
+                    section: Shape2::Disc {
+                        centre: Vector2::zeros(),
+                        radius: *radius,
+                    },
+                    length: *length,
+                    origin: *base,
+                    axes: nalgebra::Matrix3::from_rows(&[
+                        u.transpose(),
+                        v.transpose(),
+                        w.transpose(),
+                    ]),
+                })
             }
         }
     }

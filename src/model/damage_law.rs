@@ -113,10 +113,7 @@ where
     /// slot (MODEL.md §3 erratum), for its force states (3.8).
     #[inline(always)]
     pub fn modulus(&self, k: usize) -> f64 {
-        match self.second {
-            Some((c, first)) if k >= first => self.a + c,
-            _ => self.a,
-        }
+        crate::model::force_state::slot_modulus(self.a, self.second, k)
     }
 }
 

@@ -513,14 +513,7 @@ where
 impl Layout<3, 6> for Voigt6 {
     #[inline(always)]
     fn projector(n: &Vector<3>) -> Vector6<f64> {
-        Vector6::new(
-            n.x * n.x,
-            n.y * n.y,
-            n.z * n.z,
-            n.y * n.z,
-            n.x * n.z,
-            n.x * n.y,
-        )
+        crate::geometry::solid::dyad_voigt(n)
     }
     #[inline(always)]
     fn strain_to_voigt(e: &Matrix3<f64>) -> Vector6<f64> {

@@ -30,6 +30,17 @@ pub fn dilatation_term(b: f64, stretch_sum: f64) -> f64 {
     b * stretch_sum
 }
 
+/// Particle i's own bond modulus in slot k: a_i, or a_i + c_i in an FCC second-neighbour
+/// slot (MODEL.md §3 erratum); `second` is (c_i, the first second-neighbour slot), `None`
+/// without second neighbours.
+#[inline(always)]
+pub fn slot_modulus(a: f64, second: Option<(f64, usize)>, k: usize) -> f64 {
+    match second {
+        Some((c, first)) if k >= first => a + c,
+        _ => a,
+    }
+}
+
 /// Force state F_s,ij = a_i·S_ij + bθ_i (3.8).
 #[inline(always)]
 pub fn force_state(a: f64, stretch: f64, b_theta: f64) -> f64 {

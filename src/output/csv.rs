@@ -49,8 +49,9 @@ pub const PARTICLE_COLUMNS_3D: [&str; 12] = [
 /// Columns particles.csv adds for scenes with damage: w_t, w_c and yielded (0 or 1).
 pub const DAMAGE_COLUMNS: [&str; 3] = ["tensile_damage", "compressive_damage", "yielded"];
 
-/// particles.csv: one row per particle at the end of the run: reference position, displacement,
-/// (in 3D with z, u_z and the six stress components) recovered stress (`run::stress_recovery`) and, with damage, w_t, w_c and whether it yielded.
+/// particles.csv: one row per particle at the end of the run: reference position,
+/// displacement, recovered stress (`run::stress_recovery`; in 3D with z, u_z and the six
+/// stress components) and, with damage, w_t, w_c and whether it yielded.
 pub fn write_particles(o: &crate::run::Outcome, path: &Path) -> anyhow::Result<()> {
     let mut w = ::csv::Writer::from_path(path)
         .with_context(|| format!("cannot write {}", path.display()))?;

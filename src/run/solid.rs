@@ -137,23 +137,6 @@ pub fn prepare_model_solid(
         )
     })?;
     let section = scene.section_along_z();
-    // a strip follows a section along z: refuse it where the body has none
-    if section.is_none() {
-        if let Some(g) = scene
-            .groups
-            .iter()
-            .find(|g| matches!(g.select, crate::scene::Selection::Strip { .. }))
-        {
-            return Err(refuse(
-                &format!("groups.{}.select", g.name),
-                g.select.scene_text(),
-                &format!(
-                    "a strip follows the section of a prism or of a cylinder along z, and this body (\"{}\") has none: select a face with by = \"edge\", or a region with by = \"box\"",
-                    scene.body.name()
-                ),
-            ));
-        }
-    }
     let (lo, hi) = solid.bounding_box();
     let extent = format!(
         "x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m, z ∈ [{:.6}, {:.6}] m",

@@ -246,6 +246,16 @@ impl Scene {
                             "bottom, top, left or right: a strip runs along the body's section (in 3D along z, the generatrix of a cylinder or a prism)",
                         ));
                     }
+                    if dim == 3 && !self.has_section_along_z() {
+                        return Err(invalid(
+                            format!("{key}.select"),
+                            g.select.scene_text(),
+                            format!(
+                                "a strip follows the section of a prism or of a cylinder along z, and this body (\"{}\") has none: select a face with by = \"edge\", or a region with by = \"box\"",
+                                self.body.name()
+                            ),
+                        ));
+                    }
                     positive(&format!("{key}.select.width"), *width)?;
                     finite(&format!("{key}.select.centre"), *centre)?;
                     if let Some(dp) = depth {
@@ -837,12 +847,16 @@ impl Scene {
     /// The 2D section a 3D body keeps all along z (a prism's, a cylinder's along z: the
     /// plane in which its strips are drawn); `None` for other bodies.
     pub fn section_along_z(&self) -> Option<crate::geometry::Shape2> {
-        let along_z = match &self.body {
+        self.has_section_along_z().then(|| self.shape())
+    }
+
+    /// Whether the body is a prism or a cylinder along z ([`Self::section_along_z`]).
+    fn has_section_along_z(&self) -> bool {
+        match &self.body {
             BodySpec::Prism { .. } => true,
             BodySpec::Cylinder { axis, .. } => z_axis_only(axis),
             _ => false,
-        };
-        along_z.then(|| self.shape())
+        }
     }
 
     /// The solid of a 3D scene: a box, a cylinder (its axis normalised), or the prism of

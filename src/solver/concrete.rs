@@ -474,7 +474,7 @@ where
         used: &s.used,
         undamaged: s.same,
         a: m.a[i],
-        second: m.second.as_ref().map(|s| (s.c[i], s.first_slot)),
+        second: m.second_of(i),
         b_theta_elastic: dilatation_term(m.b[i], s.theta_e),
         lengths: &c.length,
         criteria_strain: mean_strain.as_ref(),

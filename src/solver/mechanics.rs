@@ -233,19 +233,21 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
     /// state `force_state(mi, S, bθ_i)` with (mi, mj) from here.
     #[inline(always)]
     pub fn bond_moduli(&self, i: usize, j: usize, k: usize) -> (f64, f64) {
-        match &self.second {
-            Some(s) if k >= s.first_slot => (self.a[i] + s.c[i], self.a[j] + s.c[j]),
-            _ => (self.a[i], self.a[j]),
-        }
+        (self.slot_modulus(i, k), self.slot_modulus(j, k))
     }
 
-    /// Particle i's own bond modulus in slot k: a_i, or a_i + c_i in a second-neighbour slot.
+    /// Particle i's own bond modulus in slot k: a_i, or a_i + c_i in a second-neighbour slot
+    /// (`force_state::slot_modulus`).
     #[inline(always)]
     pub fn slot_modulus(&self, i: usize, k: usize) -> f64 {
-        match &self.second {
-            Some(s) if k >= s.first_slot => self.a[i] + s.c[i],
-            _ => self.a[i],
-        }
+        crate::model::force_state::slot_modulus(self.a[i], self.second_of(i), k)
+    }
+
+    /// (c_i, the first second-neighbour slot), `None` without second neighbours: what
+    /// `force_state::slot_modulus` and the damage laws (`ParticleBonds::second`) take.
+    #[inline(always)]
+    pub fn second_of(&self, i: usize) -> Option<(f64, usize)> {
+        self.second.as_ref().map(|s| (s.c[i], s.first_slot))
     }
 
     /// Panics when the model has second-neighbour moduli: for the kernels that do not
