@@ -4,12 +4,12 @@
 //! The same two gather passes per step, parallel over fixed chunks of particles with no
 //! scatter, atomics or allocation, so results do not depend on the thread count:
 //!
-//! 1. `bθ_i = b_i·Σ_m S_im` (3.8) from the current positions, storing each bond's total
-//!    stretch S_ij (3.10) and inverse current length 1/|x_j − x_i| in a per-bond cache;
+//! 1. `bθ_i = b_i·Σ_m S_im` (3.8) from the current positions;
 //! 2. for each particle, over its own bonds: the bond force
-//!    F_b,ij = ½((a_i + a_j)·S_ij + bθ_i + bθ_j) (3.7, 3.8) along e_ij (stretch and 1/length
-//!    from the cache), plus the bond damper (3.55), then central differences (3.58) with the
-//!    particle damper (3.56) taken semi-implicitly (`solver::kernel::central_difference`).
+//!    F_b,ij = ½((a_i + a_j)·S_ij + bθ_i + bθ_j) (3.7, 3.8) along e_ij, plus the bond damper
+//!    (3.55), then central differences (3.58) with the particle damper (3.56) taken
+//!    semi-implicitly (`solver::kernel::central_difference`). Each bond's stretch and length
+//!    are computed again, as in the slot kernel (`solver::kernel::step`).
 //!
 //! The scalar path takes the force law from `model::force_state` and `model::stretch`; the
 //! AVX path below performs the same operations lane by lane. Per-particle data
@@ -45,24 +45,17 @@ use rayon::prelude::*;
 /// Particles treated together, one per lane. [`chunk_len`] is a multiple of it.
 pub const LANES: usize = 4;
 
-/// Length of the bond cache (`State::bond_cache`) the CSR [`step`] uses: the stretch and the
-/// inverse current length of every directed bond, interleaved.
-pub fn bond_cache_len(csr: &Csr) -> usize {
-    2 * csr.neighbours().len()
-}
-
 /// Bytes per particle-step the elastic CSR [`step`] streams in dimension `d` with bond
 /// dampers, for `bonds` directed bonds per particle: each array read or written once per pass
 /// that touches it, neighbours' data assumed in cache, write-allocate not counted. Pass 1
 /// reads the offset (4), x_i (8d) and b_i (8) and writes bθ_i (8); per bond it reads j (4)
-/// and 1/L0 (8) and writes the cache (16). Pass 2 reads the offset (4), x_i and v_i (16d),
-/// a_i, bθ_i, c_in,i, c_ex,i and 1/m_i (40), writes x, v and F (24d) and reads and writes the
-/// damper work (16); per bond it reads j (4) and the cache (16), not 1/L0. In 2D with six
-/// bonds: 36 + 168 + 140 + 120 = 464 B. The slot kernel, counted alike, reads its 6 neighbour
-/// slots in both passes: 412 B on a lattice, whose 1/L0 per slot is one value
-/// (`Mechanics::slot_inv_l0`), 460 B where pass 1 reads each particle's 1/L0 row.
+/// and 1/L0 (8). Pass 2 reads the offset (4), x_i and v_i (16d), a_i, bθ_i, c_in,i, c_ex,i
+/// and 1/m_i (40), writes x, v and F (24d) and reads and writes the damper work (16); per
+/// bond it reads j (4) and 1/L0 (8) again. In 2D with six bonds: 36 + 72 + 140 + 72 = 320 B.
+/// The slot kernel, counted alike, reads its 6 neighbour slots in both passes: 296 B on a
+/// lattice, whose 1/L0 per slot is one value (`Mechanics::slot_inv_l0`).
 pub const fn bytes_per_particle_step(d: usize, bonds: usize) -> usize {
-    (4 + 8 * d + 8 + 8) + bonds * (4 + 8 + 16) + (4 + 16 * d + 40 + 24 * d + 16) + bonds * (4 + 16)
+    (4 + 8 * d + 8 + 8) + bonds * (4 + 8) + (4 + 16 * d + 40 + 24 * d + 16) + bonds * (4 + 8)
 }
 
 /// Check the per-particle arrays against the bonds (the gathers rely on it).
@@ -79,56 +72,42 @@ fn check_sizes<const D: usize, const K: usize>(csr: &Csr, m: &Mechanics<D, K>, n
     m.assert_no_second("the CSR kernel");
 }
 
-/// b_i·Σ_m S_im of particle i; with `CACHE`, each bond's stretch and inverse length go to
-/// `cache` (the chunk's cache, whose first bond is flat bond `first`).
+/// b_i·Σ_m S_im of particle i.
 #[inline(always)]
-fn dilatation_one<const D: usize, const K: usize, const CACHE: bool>(
+fn dilatation_one<const D: usize, const K: usize>(
     csr: &Csr,
     m: &Mechanics<D, K>,
     x: &[SVector<f64, D>],
     i: usize,
-    first: usize,
-    cache: &mut [f64],
 ) -> f64 {
     let (nb, il) = (csr.neighbours(), csr.inv_l0());
     let xi = x[i];
     let mut s = 0.0;
     for b in csr.range(i) {
         let len = (x[nb[b] as usize] - xi).norm();
-        let st = total_stretch(len, il[b]);
-        if CACHE {
-            let c = 2 * (b - first);
-            cache[c] = st;
-            cache[c + 1] = 1.0 / len;
-        }
-        s += st;
+        s += total_stretch(len, il[b]);
     }
     dilatation_term(m.b[i], s)
 }
 
-/// Pass 1 over the particles `base..base + out.len()` (with `CACHE`, storing each bond's
-/// stretch and inverse length into `cache`, the part of the bond cache of those particles):
-/// whole blocks of [`LANES`] particles on the AVX path where `avx`, the rest one at a time.
-fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
+/// Pass 1 over the particles `base..base + out.len()`: whole blocks of [`LANES`] particles on
+/// the AVX path where `avx`, the rest one at a time.
+fn dilatation_chunk<const D: usize, const K: usize>(
     csr: &Csr,
     m: &Mechanics<D, K>,
     x: &[SVector<f64, D>],
     base: usize,
     out: &mut [f64],
-    cache: &mut [f64],
     avx: bool,
 ) {
     let end = base + out.len();
     assert!(end <= csr.len() && csr.len() == x.len() && m.b.len() == x.len());
-    let first = csr.offsets()[base] as usize;
-    assert!(!CACHE || cache.len() == 2 * (csr.offsets()[end] as usize - first));
     #[cfg(target_arch = "x86_64")]
     let done = if avx {
         let done = out.len() / LANES * LANES;
         // SAFETY: AVX is available (`use_avx`); base + done ≤ csr.len() = x.len() = m.len()
-        // and, with CACHE, cache holds the bonds of particles base..end (asserted above);
-        // a Csr's neighbours index its particles.
-        unsafe { avx::dilatation_chunk::<D, K, CACHE>(csr, m, x, base, &mut out[..done], cache) };
+        // (asserted above); a Csr's neighbours index its particles.
+        unsafe { avx::dilatation_chunk::<D, K>(csr, m, x, base, &mut out[..done]) };
         done
     } else {
         0
@@ -139,41 +118,11 @@ fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
         0
     };
     for (o, bt) in out.iter_mut().enumerate().skip(done) {
-        *bt = dilatation_one::<D, K, CACHE>(csr, m, x, base + o, first, cache);
+        *bt = dilatation_one::<D, K>(csr, m, x, base + o);
     }
 }
 
-/// Pass 1 with the cache over particles `base..base + out.len()`, whose bonds' cache is
-/// `cache`; split in halves of whole chunks run with `rayon::join`, so that each chunk gets
-/// its own part of the per-bond cache without allocating the split.
-#[allow(clippy::too_many_arguments)]
-fn dilatation_split<const D: usize, const K: usize>(
-    csr: &Csr,
-    m: &Mechanics<D, K>,
-    x: &[SVector<f64, D>],
-    base: usize,
-    chunk: usize,
-    out: &mut [f64],
-    cache: &mut [f64],
-    avx: bool,
-) {
-    let len = out.len();
-    if len > chunk {
-        let mid = len.div_ceil(chunk) / 2 * chunk;
-        let off = csr.offsets();
-        let split = 2 * (off[base + mid] - off[base]) as usize;
-        let (out_a, out_b) = out.split_at_mut(mid);
-        let (cache_a, cache_b) = cache.split_at_mut(split);
-        rayon::join(
-            || dilatation_split(csr, m, x, base, chunk, out_a, cache_a, avx),
-            || dilatation_split(csr, m, x, base + mid, chunk, out_b, cache_b, avx),
-        );
-        return;
-    }
-    dilatation_chunk::<D, K, true>(csr, m, x, base, out, cache, avx);
-}
-
-/// Pass 1: b_i·Σ_m S_im for every particle (without the cache).
+/// Pass 1: b_i·Σ_m S_im for every particle.
 pub fn pass_dilatation<const D: usize, const K: usize>(
     csr: &Csr,
     m: &Mechanics<D, K>,
@@ -186,23 +135,18 @@ pub fn pass_dilatation<const D: usize, const K: usize>(
     let chunk = chunk_len(out.len());
     out.par_chunks_mut(chunk)
         .enumerate()
-        .for_each(|(c, items)| {
-            dilatation_chunk::<D, K, false>(csr, m, x, c * chunk, items, &mut [], avx)
-        });
+        .for_each(|(c, items)| dilatation_chunk::<D, K>(csr, m, x, c * chunk, items, avx));
 }
 
 /// Internal force on particle i at positions x with velocities v (bond dampers if `DAMP`):
-/// the force and the power dissipated in its bond dampers (half of each bond's). With
-/// `CACHE`, each bond's stretch and inverse length come from `cache` (the whole bond cache,
-/// filled by pass 1 at positions x: the f64 values computed otherwise).
+/// the force and the power dissipated in its bond dampers (half of each bond's).
 #[inline(always)]
-pub fn particle_force<const D: usize, const K: usize, const DAMP: bool, const CACHE: bool>(
+pub fn particle_force<const D: usize, const K: usize, const DAMP: bool>(
     csr: &Csr,
     m: &Mechanics<D, K>,
     x: &[SVector<f64, D>],
     v: &[SVector<f64, D>],
     b_theta: &[f64],
-    cache: &[f64],
     i: usize,
 ) -> (SVector<f64, D>, f64) {
     let (nb, il) = (csr.neighbours(), csr.inv_l0());
@@ -215,12 +159,8 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool, const CA
         let j = nb[b] as usize;
         let (xj, aj, btj) = (x[j], m.a[j], b_theta[j]);
         let d = xj - xi;
-        let (e, s) = if CACHE {
-            (d * cache[2 * b + 1], cache[2 * b])
-        } else {
-            let len = d.norm();
-            (d * (1.0 / len), total_stretch(len, il[b]))
-        };
+        let len = d.norm();
+        let (e, s) = (d * (1.0 / len), total_stretch(len, il[b]));
         let mut fb = bond_force(ai, aj, s, bti, btj);
         if DAMP {
             let c = 0.5 * (m.c_in[i] + m.c_in[j]);
@@ -233,8 +173,7 @@ pub fn particle_force<const D: usize, const K: usize, const DAMP: bool, const CA
     (f, power)
 }
 
-/// What pass 2 reads: the bonds, the model, the state at step n, the bond cache (with
-/// `CACHE`) and the step size.
+/// What pass 2 reads: the bonds, the model, the state at step n and the step size.
 #[derive(Clone, Copy)]
 struct Inputs<'a, const D: usize, const K: usize> {
     csr: &'a Csr,
@@ -243,19 +182,12 @@ struct Inputs<'a, const D: usize, const K: usize> {
     v: &'a [SVector<f64, D>],
     b_theta: &'a [f64],
     force_prev: &'a [SVector<f64, D>],
-    cache: &'a [f64],
     dt: f64,
 }
 
 /// Pass 2 over one chunk starting at particle `base`: whole blocks of [`LANES`] particles on
 /// the AVX path where `avx`, the rest one at a time.
-fn update_chunk<
-    const D: usize,
-    const K: usize,
-    const LAG: bool,
-    const DAMP: bool,
-    const CACHE: bool,
->(
+fn update_chunk<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     inp: Inputs<'_, D, K>,
     base: usize,
     out: ChunkOut<'_, D>,
@@ -268,7 +200,6 @@ fn update_chunk<
         v,
         b_theta,
         force_prev,
-        cache,
         dt,
     } = inp;
     let mut out = out;
@@ -277,14 +208,12 @@ fn update_chunk<
     assert!(base + len <= n && csr.len() == n && v.len() == n && b_theta.len() == n);
     assert!(force_prev.len() == n && out.xn.len() == len);
     assert!(out.vn.len() == len && out.fo.len() == len);
-    assert!(!CACHE || cache.len() == bond_cache_len(csr));
     #[cfg(target_arch = "x86_64")]
     let done = if avx {
         let done = len / LANES * LANES;
         // SAFETY: AVX is available (`use_avx`); base + done ≤ n, every state array has n
-        // entries and the model too (`check_sizes`), the cache its full length (asserted
-        // above); a Csr's neighbours index its particles.
-        unsafe { avx::update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out.head(done)) };
+        // entries and the model too (`check_sizes`); a Csr's neighbours index its particles.
+        unsafe { avx::update_chunk::<D, K, LAG, DAMP>(inp, base, out.head(done)) };
         done
     } else {
         0
@@ -297,7 +226,7 @@ fn update_chunk<
     let ChunkOut { xn, vn, fo, dw } = out;
     for o in done..len {
         let i = base + o;
-        let (f, power) = particle_force::<D, K, DAMP, CACHE>(csr, m, x, v, b_theta, cache, i);
+        let (f, power) = particle_force::<D, K, DAMP>(csr, m, x, v, b_theta, i);
         fo[o] = f;
         let drive = if LAG { force_prev[i] } else { f };
         central_difference::<D, K, DAMP>(
@@ -306,15 +235,9 @@ fn update_chunk<
     }
 }
 
-/// Pass 2 (with `CACHE`, reading the cache pass 1 left at the same positions): forces and
-/// the central-difference update of every particle into x_next, v_next.
-fn pass_update_impl<
-    const D: usize,
-    const K: usize,
-    const LAG: bool,
-    const DAMP: bool,
-    const CACHE: bool,
->(
+/// Pass 2: forces and the central-difference update of every particle into x_next, v_next,
+/// from bθ as [`pass_dilatation`] left it.
+pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     csr: &Csr,
     m: &Mechanics<D, K>,
     st: &mut State<D>,
@@ -322,7 +245,6 @@ fn pass_update_impl<
 ) {
     let n = st.x.len();
     check_sizes(csr, m, n);
-    assert!(!CACHE || st.bond_cache.len() == bond_cache_len(csr));
     let avx = use_avx();
     update_in_chunks(st, n, |base, r, out| {
         let inp = Inputs {
@@ -332,54 +254,22 @@ fn pass_update_impl<
             v: r.v,
             b_theta: r.b_theta,
             force_prev: r.force_prev,
-            cache: r.cache,
             dt,
         };
-        update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out, avx)
+        update_chunk::<D, K, LAG, DAMP>(inp, base, out, avx)
     });
 }
 
-/// Pass 2 without the bond cache: forces and the central-difference update of every
-/// particle into x_next, v_next, from bθ as [`pass_dilatation`] left it.
-pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
-    csr: &Csr,
-    m: &Mechanics<D, K>,
-    st: &mut State<D>,
-    dt: f64,
-) {
-    pass_update_impl::<D, K, LAG, DAMP, false>(csr, m, st, dt);
-}
-
-/// One explicit step from x^n, v^{n−½} to x^{n+1}, v^{n+½} (not yet swapped in): pass 1,
-/// which also fills the per-bond cache of stretch and inverse length, then pass 2 reading
-/// it. `st.bond_cache` is resized to [`bond_cache_len`] on the first step if it was made for
-/// another layout (`State::at_rest` sizes it for slots).
+/// One explicit step from x^n, v^{n−½} to x^{n+1}, v^{n+½} (not yet swapped in): pass 1
+/// ([`pass_dilatation`]), then pass 2 ([`pass_update`]).
 pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     csr: &Csr,
     m: &Mechanics<D, K>,
     st: &mut State<D>,
     dt: f64,
 ) {
-    let n = st.x.len();
-    check_sizes(csr, m, n);
-    assert!(st.b_theta.len() == n);
-    let len = bond_cache_len(csr);
-    if st.bond_cache.len() != len {
-        st.bond_cache = crate::aligned::filled(0.0, len);
-    }
-    let avx = use_avx();
-    let chunk = chunk_len(n);
-    dilatation_split(
-        csr,
-        m,
-        &st.x,
-        0,
-        chunk,
-        &mut st.b_theta,
-        &mut st.bond_cache,
-        avx,
-    );
-    pass_update_impl::<D, K, LAG, DAMP, true>(csr, m, st, dt);
+    pass_dilatation(csr, m, &st.x, &mut st.b_theta);
+    pass_update::<D, K, LAG, DAMP>(csr, m, st, dt);
 }
 
 /// Explicit AVX (4 × f64) versions of the block code, one particle per lane, bond k of the
@@ -450,22 +340,17 @@ mod avx {
         gather(csr.inv_l0(), b)
     }
 
-    /// b_i·Σ_m S_im of particles i0..i0+4 (`super::dilatation_one` per lane); with `CACHE`,
-    /// each bond's stretch and inverse length into `cache`, the bond cache from flat bond
-    /// `first` on.
+    /// b_i·Σ_m S_im of particles i0..i0+4 (`super::dilatation_one` per lane).
     ///
     /// # Safety
-    /// AVX available; i0 + 4 ≤ csr.len() = x.len() = m.b.len(); with `CACHE`, cache holds
-    /// the bonds of particles i0..i0+4 from `first` on.
+    /// AVX available; i0 + 4 ≤ csr.len() = x.len() = m.b.len().
     #[target_feature(enable = "avx")]
     #[inline]
-    unsafe fn dilatation_block<const D: usize, const K: usize, const CACHE: bool>(
+    unsafe fn dilatation_block<const D: usize, const K: usize>(
         csr: &Csr,
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
         i0: usize,
-        first: usize,
-        cache: &mut [f64],
     ) -> __m256d {
         let one = _mm256_set1_pd(1.0);
         let (start, count, most) = lane_bonds(csr, i0);
@@ -476,19 +361,6 @@ mod avx {
             let (_, len) = geometry(&xi, &gather_vec(x, &j));
             // total_stretch: len·(1/L0) − 1
             let st = _mm256_sub_pd(_mm256_mul_pd(len, inv_l0(csr, &b)), one);
-            if CACHE {
-                let rinv = _mm256_div_pd(one, len);
-                let (mut sa, mut ra) = ([0.0; 4], [0.0; 4]);
-                _mm256_storeu_pd(sa.as_mut_ptr(), st);
-                _mm256_storeu_pd(ra.as_mut_ptr(), rinv);
-                for l in 0..4 {
-                    if k < count[l] {
-                        let at = 2 * (b[l] - first);
-                        *cache.get_unchecked_mut(at) = sa[l];
-                        *cache.get_unchecked_mut(at + 1) = ra[l];
-                    }
-                }
-            }
             s = _mm256_blendv_pd(s, _mm256_add_pd(s, st), occ);
         }
         // dilatation_term: b·Σ S
@@ -498,20 +370,17 @@ mod avx {
     /// Pass 1 over whole blocks: `out` holds particles base.., a multiple of 4 of them.
     ///
     /// # Safety
-    /// AVX available; base + out.len() ≤ csr.len() = x.len() = m.b.len(); with `CACHE`,
-    /// cache holds the bonds of those particles from their first on.
+    /// AVX available; base + out.len() ≤ csr.len() = x.len() = m.b.len().
     #[target_feature(enable = "avx")]
-    pub unsafe fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
+    pub unsafe fn dilatation_chunk<const D: usize, const K: usize>(
         csr: &Csr,
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
         base: usize,
         out: &mut [f64],
-        cache: &mut [f64],
     ) {
-        let first = *csr.offsets().get_unchecked(base) as usize;
         for o in (0..out.len()).step_by(4) {
-            let r = dilatation_block::<D, K, CACHE>(csr, m, x, base + o, first, cache);
+            let r = dilatation_block::<D, K>(csr, m, x, base + o);
             _mm256_storeu_pd(out.as_mut_ptr().add(o), r);
         }
     }
@@ -521,16 +390,15 @@ mod avx {
     ///
     /// # Safety
     /// AVX available; i0 + 4 ≤ csr.len(); x, v, b_theta and the model have csr.len()
-    /// entries; with `CACHE`, cache is the whole bond cache, filled by pass 1 at positions x.
+    /// entries.
     #[target_feature(enable = "avx")]
     #[inline]
-    unsafe fn force_block<const D: usize, const K: usize, const DAMP: bool, const CACHE: bool>(
+    unsafe fn force_block<const D: usize, const K: usize, const DAMP: bool>(
         csr: &Csr,
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
         v: &[SVector<f64, D>],
         b_theta: &[f64],
-        cache: &[f64],
         i0: usize,
     ) -> ([__m256d; D], __m256d) {
         let one = _mm256_set1_pd(1.0);
@@ -554,22 +422,9 @@ mod avx {
         for k in 0..most {
             let (b, j, occ) = bond_k(csr, &start, &count, i0, k);
             let xj = gather_vec(x, &j);
-            let mut d = [_mm256_setzero_pd(); D];
-            for c in 0..D {
-                d[c] = _mm256_sub_pd(xj[c], xi[c]);
-            }
-            let (rinv, st) = if CACHE {
-                // the (S, 1/len) pairs of the four bonds, transposed
-                let p = cache.as_ptr();
-                let r = |l: usize| _mm_loadu_pd(p.add(2 * b[l]));
-                let lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(0)), r(2), 1);
-                let hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(r(1)), r(3), 1);
-                (_mm256_unpackhi_pd(lo, hi), _mm256_unpacklo_pd(lo, hi))
-            } else {
-                let (_, len) = geometry(&xi, &xj);
-                let st = _mm256_sub_pd(_mm256_mul_pd(len, inv_l0(csr, &b)), one);
-                (_mm256_div_pd(one, len), st)
-            };
+            let (d, len) = geometry(&xi, &xj);
+            let st = _mm256_sub_pd(_mm256_mul_pd(len, inv_l0(csr, &b)), one);
+            let rinv = _mm256_div_pd(one, len);
             let aj = gather(&m.a, &j);
             let btj = gather(b_theta, &j);
             // bond_force: 0.5 * ((ai + aj) * s + bti + btj)
@@ -610,15 +465,13 @@ mod avx {
     ///
     /// # Safety
     /// AVX available; base + xn.len() ≤ csr.len(); x, v, b_theta, force_prev and the model
-    /// have csr.len() entries, vn, fo and dw xn.len(); with `CACHE`, cache is the whole bond
-    /// cache, filled by pass 1 at positions x.
+    /// have csr.len() entries, vn, fo and dw xn.len().
     #[target_feature(enable = "avx")]
     pub(super) unsafe fn update_chunk<
         const D: usize,
         const K: usize,
         const LAG: bool,
         const DAMP: bool,
-        const CACHE: bool,
     >(
         inp: Inputs<'_, D, K>,
         base: usize,
@@ -631,13 +484,12 @@ mod avx {
             v,
             b_theta,
             force_prev,
-            cache,
             dt,
         } = inp;
         let ChunkOut { xn, vn, fo, dw } = out;
         for o0 in (0..xn.len()).step_by(4) {
             let i0 = base + o0;
-            let (f, power) = force_block::<D, K, DAMP, CACHE>(csr, m, x, v, b_theta, cache, i0);
+            let (f, power) = force_block::<D, K, DAMP>(csr, m, x, v, b_theta, i0);
             let mut fa = [[0.0; 4]; D];
             for c in 0..D {
                 _mm256_storeu_pd(fa[c].as_mut_ptr(), f[c]);
@@ -729,25 +581,17 @@ mod tests {
     }
 
     /// The kernel (AVX blocks where the CPU has AVX, chunk tails one at a time) against the
-    /// plain per-particle code, bit for bit, on 1 and 2 threads, with and without the cache.
+    /// plain per-particle code, bit for bit, on 1 and 2 threads.
     fn check<const D: usize, const LAG: bool, const DAMP: bool>() {
         let n = 2 * CHUNK + 4 * 37 + 3;
         let (csr, m, st0) = model::<D>(n);
         let dt = 1e-7;
         let mut want = st0.clone();
         for i in 0..n {
-            want.b_theta[i] = dilatation_one::<D, 0, false>(&csr, &m, &st0.x, i, 0, &mut []);
+            want.b_theta[i] = dilatation_one::<D, 0>(&csr, &m, &st0.x, i);
         }
         for i in 0..n {
-            let (f, p) = particle_force::<D, 0, DAMP, false>(
-                &csr,
-                &m,
-                &st0.x,
-                &st0.v,
-                &want.b_theta,
-                &[],
-                i,
-            );
+            let (f, p) = particle_force::<D, 0, DAMP>(&csr, &m, &st0.x, &st0.v, &want.b_theta, i);
             want.force[i] = f;
             let drive = if LAG { st0.force_prev[i] } else { f };
             central_difference::<D, 0, DAMP>(
@@ -774,28 +618,19 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            for cached in [true, false] {
-                let mut st = st0.clone();
-                pool.install(|| {
-                    if cached {
-                        step::<D, 0, LAG, DAMP>(&csr, &m, &mut st, dt)
-                    } else {
-                        pass_dilatation(&csr, &m, &st.x, &mut st.b_theta);
-                        pass_update::<D, 0, LAG, DAMP>(&csr, &m, &mut st, dt)
-                    }
-                });
-                assert_eq!(sbits(&st.b_theta), sbits(&want.b_theta));
-                assert_eq!(bits(&st.force), bits(&want.force));
-                assert_eq!(bits(&st.x_next), bits(&want.x_next));
-                assert_eq!(bits(&st.v_next), bits(&want.v_next));
-                assert_eq!(sbits(&st.damping_work), sbits(&want.damping_work));
-            }
+            let mut st = st0.clone();
+            pool.install(|| step::<D, 0, LAG, DAMP>(&csr, &m, &mut st, dt));
+            assert_eq!(sbits(&st.b_theta), sbits(&want.b_theta));
+            assert_eq!(bits(&st.force), bits(&want.force));
+            assert_eq!(bits(&st.x_next), bits(&want.x_next));
+            assert_eq!(bits(&st.v_next), bits(&want.v_next));
+            assert_eq!(sbits(&st.damping_work), sbits(&want.damping_work));
         }
     }
 
     #[test]
     fn bytes_per_particle_step_in_2d() {
-        assert_eq!(bytes_per_particle_step(2, 6), 464);
+        assert_eq!(bytes_per_particle_step(2, 6), 320);
     }
 
     #[test]

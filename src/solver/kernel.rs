@@ -58,10 +58,6 @@ pub struct State<const D: usize> {
     pub b_theta: Aligned<f64>,
     /// Work done on each particle's dampers so far (J).
     pub damping_work: Aligned<f64>,
-    /// Per-slot stretch S and 1/|x_j − x_i| (0 in empty slots) from pass 1 of the current
-    /// [`step`], reused by pass 2; laid out in blocks of [`LANES`] particles (see
-    /// [`bond_cache_len`]). Scratch: it carries nothing from one step to the next.
-    pub bond_cache: Aligned<f64>,
 }
 
 impl<const D: usize> State<D> {
@@ -79,7 +75,6 @@ impl<const D: usize> State<D> {
             force_prev: z(),
             b_theta: filled(0.0, n),
             damping_work: filled(0.0, n),
-            bond_cache: filled(0.0, bond_cache_len(n, crate::discretise::slots(D))),
         }
     }
 }
@@ -90,8 +85,7 @@ pub const LANES: usize = 4;
 /// Length of a per-slot cache of n particles with k slots and `fields` values a slot, laid
 /// out in blocks of [`LANES`] particles: block b (particles 4b..4b+4) holds, for each slot,
 /// each field as 4 consecutive values, one per lane, so that an AVX pass loads or stores a
-/// field a vector at a time (see [`lane_cache_at`]). The elastic bond cache and the concrete
-/// slot cache share it.
+/// field a vector at a time (see [`lane_cache_at`]); the concrete kernels' slot cache.
 pub const fn lane_cache_len(n: usize, k: usize, fields: usize) -> usize {
     n.div_ceil(LANES) * LANES * fields * k
 }
@@ -101,19 +95,6 @@ pub const fn lane_cache_len(n: usize, k: usize, fields: usize) -> usize {
 #[inline(always)]
 pub const fn lane_cache_at(i: usize, k: usize, slots: usize, fields: usize) -> usize {
     (i / LANES) * (fields * LANES * slots) + fields * LANES * k + i % LANES
-}
-
-/// Length of [`State::bond_cache`] for n particles with K slots: per slot the stretch, then
-/// the inverse length ([`lane_cache_len`] with two fields).
-pub const fn bond_cache_len(n: usize, k: usize) -> usize {
-    lane_cache_len(n, k, 2)
-}
-
-/// Index in [`State::bond_cache`] of the stretch in slot k of particle i (its inverse length
-/// follows LANES entries later).
-#[inline(always)]
-pub const fn bond_cache_at(i: usize, k: usize, slots: usize) -> usize {
-    lane_cache_at(i, k, slots, 2)
 }
 
 /// b_i·θ_i, θ_i = Σ_m w_im·S_im (w = 1 without weights), for particle i (scalar; chunk tails
@@ -141,41 +122,6 @@ fn dilatation_one<const D: usize, const K: usize>(
     dilatation_term(m.b[i], s)
 }
 
-/// [`dilatation_one`] that also stores each slot's stretch and inverse length (0 where the
-/// slot is empty) into `cache`, a chunk of [`State::bond_cache`] starting at particle `base`
-/// (a multiple of [`LANES`]).
-#[inline(always)]
-fn dilatation_one_cached<const D: usize, const K: usize>(
-    m: &Mechanics<D, K>,
-    x: &[SVector<f64, D>],
-    i: usize,
-    base: usize,
-    cache: &mut [f64],
-) -> f64 {
-    let xi = x[i];
-    let nb = &m.neighbours[i];
-    let il = &m.inv_l0[i];
-    let w = m.weights(i);
-    let mut s = 0.0;
-    for k in 0..K {
-        let at = bond_cache_at(i - base, k, K);
-        let j = nb[k];
-        if j == crate::discretise::NONE {
-            cache[at] = 0.0;
-            cache[at + LANES] = 0.0;
-            continue;
-        }
-        // SAFETY: Mechanics::new checks every occupied slot indexes a particle.
-        let xj = unsafe { *x.get_unchecked(j as usize) };
-        let len = (xj - xi).norm();
-        let st = total_stretch(len, il[k]);
-        cache[at] = st;
-        cache[at + LANES] = 1.0 / len;
-        s += weighted(w, k, st);
-    }
-    dilatation_term(m.b[i], s)
-}
-
 /// Whether the AVX block kernels can run on this CPU.
 #[inline]
 pub(crate) fn use_avx() -> bool {
@@ -189,28 +135,22 @@ pub(crate) fn use_avx() -> bool {
     }
 }
 
-/// Pass 1 over one chunk starting at particle `base`; with `CACHE`, also fills `cache`, the
-/// chunk's part of [`State::bond_cache`] (otherwise `cache` is unused).
+/// Pass 1 over one chunk starting at particle `base`.
 #[inline(always)]
-fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
+fn dilatation_chunk<const D: usize, const K: usize>(
     m: &Mechanics<D, K>,
     x: &[SVector<f64, D>],
     base: usize,
     chunk: &mut [f64],
-    cache: &mut [f64],
     avx: bool,
 ) {
     assert!(base + chunk.len() <= m.len() && m.len() == x.len());
-    assert!(
-        !CACHE || (base.is_multiple_of(LANES) && cache.len() >= bond_cache_len(chunk.len(), K))
-    );
     #[cfg(target_arch = "x86_64")]
     let done = if avx {
         let done = chunk.len() / LANES * LANES;
-        // SAFETY: AVX is available (`use_avx`); base + done ≤ m.len() = x.len() and, with
-        // CACHE, cache holds the blocks of those particles (asserted above); Mechanics::new
-        // checks every occupied slot indexes a particle.
-        unsafe { avx::dilatation_chunk::<D, K, CACHE>(m, x, base, &mut chunk[..done], cache) };
+        // SAFETY: AVX is available (`use_avx`); base + done ≤ m.len() = x.len() (asserted
+        // above); Mechanics::new checks every occupied slot indexes a particle.
+        unsafe { avx::dilatation_chunk::<D, K>(m, x, base, &mut chunk[..done]) };
         done
     } else {
         0
@@ -221,11 +161,7 @@ fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
         0
     };
     for (o, bt) in chunk.iter_mut().enumerate().skip(done) {
-        *bt = if CACHE {
-            dilatation_one_cached(m, x, base + o, base, cache)
-        } else {
-            dilatation_one(m, x, base + o)
-        };
+        *bt = dilatation_one(m, x, base + o);
     }
 }
 
@@ -240,30 +176,7 @@ pub fn pass_dilatation<const D: usize, const K: usize>(
     let chunk = chunk_len(out.len());
     out.par_chunks_mut(chunk)
         .enumerate()
-        .for_each(|(c, items)| {
-            dilatation_chunk::<D, K, false>(m, x, c * chunk, items, &mut [], avx)
-        });
-}
-
-/// [`pass_dilatation`] that also fills [`State::bond_cache`] for pass 2 (`cache` has
-/// [`bond_cache_len`] entries).
-fn pass_dilatation_cached<const D: usize, const K: usize>(
-    m: &Mechanics<D, K>,
-    x: &[SVector<f64, D>],
-    out: &mut [f64],
-    cache: &mut [f64],
-) {
-    assert!(x.len() == m.len() && out.len() == m.len());
-    assert!(cache.len() == bond_cache_len(m.len(), K));
-    let avx = use_avx();
-    let chunk = chunk_len(out.len());
-    debug_assert!(chunk.is_multiple_of(LANES));
-    out.par_chunks_mut(chunk)
-        .zip(cache.par_chunks_mut(2 * K * chunk))
-        .enumerate()
-        .for_each(|(c, (items, cache))| {
-            dilatation_chunk::<D, K, true>(m, x, c * chunk, items, cache, avx)
-        });
+        .for_each(|(c, items)| dilatation_chunk::<D, K>(m, x, c * chunk, items, avx));
 }
 
 /// Internal force on particle i at positions x with velocities v (bond dampers if `DAMP`);
@@ -344,8 +257,7 @@ fn particle_force_impl<const D: usize, const K: usize, const DAMP: bool, const S
     (f, power)
 }
 
-/// What pass 2 reads: the model, the state at step n (and, with the bond cache, what pass 1
-/// left at the same positions) and the step size.
+/// What pass 2 reads: the model, the state at step n and the step size.
 #[derive(Clone, Copy)]
 struct Inputs<'a, const D: usize, const K: usize> {
     m: &'a Mechanics<D, K>,
@@ -353,7 +265,6 @@ struct Inputs<'a, const D: usize, const K: usize> {
     v: &'a [SVector<f64, D>],
     b_theta: &'a [f64],
     force_prev: &'a [SVector<f64, D>],
-    cache: &'a [f64],
     dt: f64,
 }
 
@@ -428,17 +339,9 @@ pub(crate) fn central_difference<const D: usize, const K: usize, const DAMP: boo
     }
 }
 
-/// Pass 2 over one chunk starting at particle `base`; with `CACHE`, the AVX blocks take each
-/// slot's stretch and inverse length from `cache` (all of [`State::bond_cache`], filled by
-/// pass 1 at the same positions) instead of recomputing them.
+/// Pass 2 over one chunk starting at particle `base`.
 #[inline(always)]
-fn update_chunk<
-    const D: usize,
-    const K: usize,
-    const LAG: bool,
-    const DAMP: bool,
-    const CACHE: bool,
->(
+fn update_chunk<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     inp: Inputs<'_, D, K>,
     base: usize,
     out: ChunkOut<'_, D>,
@@ -450,7 +353,6 @@ fn update_chunk<
         v,
         b_theta,
         force_prev,
-        cache,
         ..
     } = inp;
     let mut out = out;
@@ -459,21 +361,20 @@ fn update_chunk<
     assert!(base + len <= n && x.len() == n && v.len() == n && b_theta.len() == n);
     assert!(force_prev.len() == n);
     assert!(out.vn.len() == len && out.fo.len() == len && out.dw.len() == len);
-    assert!(!CACHE || cache.len() == bond_cache_len(n, K));
     #[cfg(target_arch = "x86_64")]
     let done = if avx {
         let done = len / LANES * LANES;
         // SAFETY: AVX is available (`use_avx`); base + done ≤ n and every state array has n
-        // entries, the cache its full length (asserted above); Mechanics::new checks every
-        // occupied slot indexes a particle.
-        unsafe { avx::update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out.head(done)) };
+        // entries (asserted above); Mechanics::new checks every occupied slot indexes a
+        // particle.
+        unsafe { avx::update_chunk::<D, K, LAG, DAMP>(inp, base, out.head(done)) };
         done
     } else {
         0
     };
     #[cfg(not(target_arch = "x86_64"))]
     let done = {
-        let _ = (avx, cache);
+        let _ = avx;
         0
     };
     let ChunkOut { xn, vn, fo, dw } = out;
@@ -491,22 +392,6 @@ pub fn pass_update<const D: usize, const K: usize, const LAG: bool, const DAMP: 
     st: &mut State<D>,
     dt: f64,
 ) {
-    pass_update_impl::<D, K, LAG, DAMP, false>(m, st, dt);
-}
-
-/// [`pass_update`], with `CACHE` reading [`State::bond_cache`] as left by
-/// [`pass_dilatation_cached`] at the same positions.
-fn pass_update_impl<
-    const D: usize,
-    const K: usize,
-    const LAG: bool,
-    const DAMP: bool,
-    const CACHE: bool,
->(
-    m: &Mechanics<D, K>,
-    st: &mut State<D>,
-    dt: f64,
-) {
     let n = m.len();
     let avx = use_avx();
     update_in_chunks(st, n, |base, r, out| {
@@ -516,10 +401,9 @@ fn pass_update_impl<
             v: r.v,
             b_theta: r.b_theta,
             force_prev: r.force_prev,
-            cache: r.cache,
             dt,
         };
-        update_chunk::<D, K, LAG, DAMP, CACHE>(inp, base, out, avx)
+        update_chunk::<D, K, LAG, DAMP>(inp, base, out, avx)
     });
 }
 
@@ -529,7 +413,6 @@ pub(crate) struct StateReads<'a, const D: usize> {
     pub v: &'a [SVector<f64, D>],
     pub b_theta: &'a [f64],
     pub force_prev: &'a [SVector<f64, D>],
-    pub cache: &'a [f64],
 }
 
 /// Pass 2's parallel frame, shared by the slot and the CSR kernels: checks that every
@@ -550,7 +433,6 @@ pub(crate) fn update_in_chunks<const D: usize>(
         force_prev,
         b_theta,
         damping_work,
-        bond_cache,
     } = st;
     assert!([
         x.len(),
@@ -565,7 +447,6 @@ pub(crate) fn update_in_chunks<const D: usize>(
     .iter()
     .all(|&l| l == n));
     let (x, v, b_theta, force_prev) = (&x[..], &v[..], &b_theta[..], &force_prev[..]);
-    let cache = &bond_cache[..];
     let chunk = chunk_len(n);
     x_next
         .par_chunks_mut(chunk)
@@ -579,27 +460,23 @@ pub(crate) fn update_in_chunks<const D: usize>(
                 v,
                 b_theta,
                 force_prev,
-                cache,
             };
             update(c * chunk, reads, ChunkOut { xn, vn, fo, dw })
         });
 }
 
 /// One explicit step from x^n, v^{n−½} to x^{n+1}, v^{n+½} (not yet swapped in): pass 1
-/// ([`pass_dilatation`]) and pass 2 ([`pass_update`]), pass 2 reusing the stretches and
-/// inverse bond lengths pass 1 computed (the same f64 values, so the same results).
+/// ([`pass_dilatation`]) and pass 2 ([`pass_update`]). Pass 2 recomputes each bond's length
+/// rather than reading it from a per-bond cache written by pass 1: on the 2-core Xeon the
+/// cache's 16 B per bond of traffic cost more than the square roots and divisions it saved
+/// (benchmarks/RESULTS.md, "Without the bond cache").
 pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
     m: &Mechanics<D, K>,
     st: &mut State<D>,
     dt: f64,
 ) {
-    let len = bond_cache_len(m.len(), K);
-    if st.bond_cache.len() != len {
-        // Only where the state was made for another slot count (see State::at_rest).
-        st.bond_cache = filled(0.0, len);
-    }
-    pass_dilatation_cached(m, &st.x, &mut st.b_theta, &mut st.bond_cache);
-    pass_update_impl::<D, K, LAG, DAMP, true>(m, st, dt);
+    pass_dilatation(m, &st.x, &mut st.b_theta);
+    pass_update::<D, K, LAG, DAMP>(m, st, dt);
 }
 
 /// Explicit AVX (4 × f64) versions of the block kernels, one particle per lane. They perform
@@ -607,7 +484,7 @@ pub fn step<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>(
 /// results are bit-identical to it.
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx {
-    use super::{bond_cache_at, ChunkOut, Inputs, Mechanics, LANES};
+    use super::{ChunkOut, Inputs, Mechanics, LANES};
     use crate::discretise::NONE;
     use core::arch::x86_64::*;
     use nalgebra::SVector;
@@ -762,27 +639,18 @@ pub(crate) mod avx {
     }
 
     /// b_i·θ_i (θ_i = Σ_m w_im·S_im, w = 1 without weights) for particles i0..i0+4 into
-    /// out[0..4]; with `CACHE`, also each slot's
-    /// stretch and inverse length (both 0 where the slot is empty) into the block's part of
-    /// the bond cache at `cache` (see `super::bond_cache_at`). `WEIGHTED` is whether the body
-    /// weighs its dilatations (`m.dilatation_weight`), a test hoisted out of the slot loop.
+    /// out[0..4]. `WEIGHTED` is whether the body weighs its dilatations
+    /// (`m.dilatation_weight`), a test hoisted out of the slot loop.
     ///
     /// # Safety
-    /// AVX available; i0 + 4 ≤ m.len() = x.len(); every occupied slot indexes a particle;
-    /// with `CACHE`, cache points to 8·K writable f64.
+    /// AVX available; i0 + 4 ≤ m.len() = x.len(); every occupied slot indexes a particle.
     #[target_feature(enable = "avx")]
     #[inline]
-    pub unsafe fn dilatation_block<
-        const D: usize,
-        const K: usize,
-        const CACHE: bool,
-        const WEIGHTED: bool,
-    >(
+    pub unsafe fn dilatation_block<const D: usize, const K: usize, const WEIGHTED: bool>(
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
         i0: usize,
         out: *mut f64,
-        cache: *mut f64,
     ) {
         let one = _mm256_set1_pd(1.0);
         let xi = load_own(x, i0);
@@ -792,11 +660,6 @@ pub(crate) mod avx {
             let (_, len) = geometry(&xi, &gather_vec(x, &j));
             // total_stretch: len·(1/L0) − 1
             let st = _mm256_and_pd(_mm256_sub_pd(_mm256_mul_pd(len, il), one), occ);
-            if CACHE {
-                let rinv = _mm256_and_pd(_mm256_div_pd(one, len), occ);
-                _mm256_storeu_pd(cache.add(2 * LANES * k), st);
-                _mm256_storeu_pd(cache.add(2 * LANES * k + LANES), rinv);
-            }
             // weighted dilatation (random particles): w·S, as the scalar path
             let term = match (WEIGHTED, &m.slot_weight, &m.dilatation_weight) {
                 // the same weight in every row (the FCC lattice): broadcast it
@@ -814,29 +677,25 @@ pub(crate) mod avx {
     }
 
     /// `super::particle_force` of particles i0..i0+4, one per lane, as SoA: the force per
-    /// component and the bond-damper power. With `CACHE`, each slot's stretch and inverse
-    /// length come from `cache` (the whole bond cache) instead of being recomputed. With
+    /// component and the bond-damper power. With
     /// `SECOND`, the model has second-neighbour moduli (`m.second`) and their slots take
     /// the moduli a + c, added in the scalar code's order.
     ///
     /// # Safety
     /// AVX available; i0 + 4 ≤ m.len(); x, v and b_theta have m.len() entries; every
-    /// occupied slot indexes a particle; with `CACHE`, cache holds block i0/4 and pass 1
-    /// filled it at positions x; with `SECOND`, `m.second` is `Some` with m.len() entries.
+    /// occupied slot indexes a particle; with `SECOND`, `m.second` is `Some` with m.len() entries.
     #[target_feature(enable = "avx")]
     #[inline]
     pub unsafe fn force_block<
         const D: usize,
         const K: usize,
         const DAMP: bool,
-        const CACHE: bool,
         const SECOND: bool,
     >(
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
         v: &[SVector<f64, D>],
         b_theta: &[f64],
-        cache: &[f64],
         i0: usize,
     ) -> ([__m256d; D], __m256d) {
         let one = _mm256_set1_pd(1.0);
@@ -869,19 +728,9 @@ pub(crate) mod avx {
         for k in 0..block_slots(m, i0) {
             let (j, occ, il) = slot(m, i0, k);
             let xj = gather_vec(x, &j);
-            let (d, rinv, st) = if CACHE {
-                let mut d = [_mm256_setzero_pd(); D];
-                for c in 0..D {
-                    d[c] = _mm256_sub_pd(xj[c], xi[c]);
-                }
-                let p = cache.as_ptr().add(bond_cache_at(i0, k, K));
-                (d, _mm256_loadu_pd(p.add(LANES)), _mm256_loadu_pd(p))
-            } else {
-                let (d, len) = geometry(&xi, &xj);
-                let rinv = _mm256_and_pd(_mm256_div_pd(one, len), occ);
-                let st = _mm256_and_pd(_mm256_sub_pd(_mm256_mul_pd(len, il), one), occ);
-                (d, rinv, st)
-            };
+            let (d, len) = geometry(&xi, &xj);
+            let rinv = _mm256_and_pd(_mm256_div_pd(one, len), occ);
+            let st = _mm256_and_pd(_mm256_sub_pd(_mm256_mul_pd(len, il), one), occ);
             let aj = gather(&m.a, &j);
             let btj = gather(b_theta, &j);
             // the bond moduli: (a_i + c_i, a_j + c_j) in a second-neighbour slot
@@ -924,31 +773,24 @@ pub(crate) mod avx {
         (f, power)
     }
 
-    /// Pass 1 over whole blocks: `out` holds particles base.., a multiple of 4 of them; with
-    /// `CACHE`, `cache` is the bond cache from particle base on.
+    /// Pass 1 over whole blocks: `out` holds particles base.., a multiple of 4 of them.
     ///
     /// # Safety
     /// AVX available; base + out.len() ≤ m.len() = x.len(); every occupied slot indexes a
-    /// particle; with `CACHE`, base is a multiple of 4 and cache holds 2·K·out.len() f64.
+    /// particle.
     #[target_feature(enable = "avx")]
-    pub unsafe fn dilatation_chunk<const D: usize, const K: usize, const CACHE: bool>(
+    pub unsafe fn dilatation_chunk<const D: usize, const K: usize>(
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
         base: usize,
         out: &mut [f64],
-        cache: &mut [f64],
     ) {
         for o in (0..out.len()).step_by(4) {
-            let c = if CACHE {
-                cache.as_mut_ptr().add(bond_cache_at(o, 0, K))
-            } else {
-                core::ptr::null_mut()
-            };
             // the weights' test hoisted out of the slot loop (one loop per case)
             if m.dilatation_weight.is_some() {
-                dilatation_block::<D, K, CACHE, true>(m, x, base + o, out.as_mut_ptr().add(o), c);
+                dilatation_block::<D, K, true>(m, x, base + o, out.as_mut_ptr().add(o));
             } else {
-                dilatation_block::<D, K, CACHE, false>(m, x, base + o, out.as_mut_ptr().add(o), c);
+                dilatation_block::<D, K, false>(m, x, base + o, out.as_mut_ptr().add(o));
             }
         }
     }
@@ -1060,15 +902,13 @@ pub(crate) mod avx {
     ///
     /// # Safety
     /// AVX available; base + xn.len() ≤ m.len(); x, v, b_theta and force_prev have m.len()
-    /// entries, vn, fo and dw xn.len(); every occupied slot indexes a particle; with `CACHE`,
-    /// cache is the whole bond cache, filled by pass 1 at positions x.
+    /// entries, vn, fo and dw xn.len(); every occupied slot indexes a particle.
     #[target_feature(enable = "avx")]
     pub(super) unsafe fn update_chunk<
         const D: usize,
         const K: usize,
         const LAG: bool,
         const DAMP: bool,
-        const CACHE: bool,
     >(
         inp: Inputs<'_, D, K>,
         base: usize,
@@ -1080,7 +920,6 @@ pub(crate) mod avx {
             v,
             b_theta,
             force_prev,
-            cache,
             dt,
         } = inp;
         let ChunkOut { xn, vn, fo, dw } = out;
@@ -1089,9 +928,9 @@ pub(crate) mod avx {
         for o0 in (0..xn.len()).step_by(4) {
             let i0 = base + o0;
             let (f, power) = if second {
-                force_block::<D, K, DAMP, CACHE, true>(m, x, v, b_theta, cache, i0)
+                force_block::<D, K, DAMP, true>(m, x, v, b_theta, i0)
             } else {
-                force_block::<D, K, DAMP, CACHE, false>(m, x, v, b_theta, cache, i0)
+                force_block::<D, K, DAMP, false>(m, x, v, b_theta, i0)
             };
             if vector_update {
                 update_block::<D, K, LAG, DAMP>(
@@ -1272,7 +1111,6 @@ mod tests {
                 v: &st0.v,
                 b_theta: &want.b_theta,
                 force_prev: &st0.force_prev,
-                cache: &[],
                 dt,
             };
             update_one::<D, K, LAG, DAMP>(inp, i, f, p, &mut xn, &mut vn, &mut dw);
@@ -1291,17 +1129,6 @@ mod tests {
                     .collect::<Vec<_>>()
             };
             let sbits = |v: &[f64]| v.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
-            assert_eq!(sbits(&st.b_theta), sbits(&want.b_theta));
-            assert_eq!(bits(&st.force), bits(&want.force));
-            assert_eq!(bits(&st.x_next), bits(&want.x_next));
-            assert_eq!(bits(&st.v_next), bits(&want.v_next));
-            assert_eq!(sbits(&st.damping_work), sbits(&want.damping_work));
-            // the public passes, without the bond cache
-            let mut st = st0.clone();
-            pool.install(|| {
-                pass_dilatation(m, &st.x, &mut st.b_theta);
-                pass_update::<D, K, LAG, DAMP>(m, &mut st, dt)
-            });
             assert_eq!(sbits(&st.b_theta), sbits(&want.b_theta));
             assert_eq!(bits(&st.force), bits(&want.force));
             assert_eq!(bits(&st.x_next), bits(&want.x_next));
