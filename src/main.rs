@@ -301,12 +301,12 @@ fn check<const K: usize, const D: usize>(
     say!("time step dt     {:.6e} s", p.dt);
     let threads = rayon::current_num_threads();
     let solver = &sc.solver;
-    if solver.method == sppm::scene::SolverMethod::Relaxation {
+    if solver.method.is_incremental() {
         // the iterations per increment are known only once it has converged
-        let most = solver.increments * solver.max_iterations;
+        let most = solver.increments * solver.max_iterations();
         say!(
             "solver           relaxation: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
-            solver.increments, solver.max_iterations, solver.tolerance
+            solver.increments, solver.max_iterations(), solver.tolerance
         );
         say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
         say!(

@@ -36,6 +36,38 @@ pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Column names of increments.csv: one row per load increment of a relaxation or
+/// quasi-static run (`solver::relaxation::IncrementReport`).
+pub const INCREMENT_COLUMNS: [&str; 6] = [
+    "increment",
+    "load_factor",
+    "iterations",
+    "commits",
+    "residual",
+    "converged",
+];
+
+pub fn write_increments(
+    increments: &[crate::solver::relaxation::IncrementReport],
+    path: &Path,
+) -> anyhow::Result<()> {
+    let mut w = ::csv::Writer::from_path(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    w.write_record(INCREMENT_COLUMNS)?;
+    for r in increments {
+        w.write_record([
+            r.increment.to_string(),
+            format!("{:e}", r.load_factor),
+            r.iterations.to_string(),
+            r.commits.to_string(),
+            format!("{:e}", r.residual),
+            r.converged.to_string(),
+        ])?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
 /// Columns of particles.csv (README, "Outputs").
 pub const PARTICLE_COLUMNS: [&str; 7] =
     ["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];

@@ -1,4 +1,5 @@
-//! Reports of a run (ARCHITECTURE.md, "Interfaces"): summary.json, force_displacement.csv, particles.csv,
+//! Reports of a run (ARCHITECTURE.md, "Interfaces"): summary.json, force_displacement.csv,
+//! increments.csv (relaxation and quasi-static runs), particles.csv,
 //! force_displacement.svg, crack_map.svg (scenes with damage), random_field_<property>.svg (each
 //! random field, with the crack on top), particle_map.svg and particles.vtk in the run's folder.
 
@@ -14,9 +15,10 @@ use std::path::{Path, PathBuf};
 
 /// The files of a run that sppm owns in its folder (besides `random_field_<property>.svg`):
 /// a new run into the folder replaces them all, so the folder only ever holds one run.
-pub const RUN_FILES: [&str; 7] = [
+pub const RUN_FILES: [&str; 8] = [
     "summary.json",
     "force_displacement.csv",
+    "increments.csv",
     "particles.csv",
     "force_displacement.svg",
     "crack_map.svg",
@@ -55,6 +57,11 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
     put("force_displacement.csv".into(), &|f| {
         csv::write_records(&outcome.records, f)
     })?;
+    if !outcome.increments.is_empty() {
+        put("increments.csv".into(), &|f| {
+            csv::write_increments(&outcome.increments, f)
+        })?;
+    }
     put("particles.csv".into(), &|f| {
         csv::write_particles(outcome, f)
     })?;

@@ -176,7 +176,7 @@ fn run_prepared<const K: usize, const D: usize>(
 ) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let method = p.model.scene.solver.method;
-    if method == SolverMethod::Relaxation {
+    if method.is_incremental() {
         // Dampers off; the step of the undamped model (see solver::relaxation).
         p.stable = relaxation::undamped(&mut p.model.mech, &p.model.particles.x0);
         p.dt = p
@@ -193,6 +193,7 @@ fn run_prepared<const K: usize, const D: usize>(
         amplitude: 0.0,
     };
     let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
+    let mut increments = Vec::new();
     let (records, wall_s, failure, report) = match method {
         SolverMethod::Explicit => {
             let (records, wall_s, failure, stopped) =
@@ -203,14 +204,17 @@ fn run_prepared<const K: usize, const D: usize>(
             };
             (records, wall_s, failure, report)
         }
-        SolverMethod::Relaxation => {
+        SolverMethod::Relaxation | SolverMethod::QuasiStatic => {
             let s = &p.model.scene.solver;
+            let quasi_static = method == SolverMethod::QuasiStatic;
             let settings = relaxation::Settings {
                 increments: s.increments,
                 tolerance: s.tolerance,
-                max_iterations: s.max_iterations,
+                max_iterations: s.max_iterations(),
                 ramp: p.model.scene.loading.ramp,
                 stop_after_peak: p.model.scene.loading.stop_after_peak,
+                staggered: quasi_static,
+                stop_unconverged: quasi_static.then(|| s.max_residual.unwrap_or(s.tolerance)),
             };
             let r = relaxation::relax(&mut sim, probe, &settings, start);
             let report = SolverReport {
@@ -219,7 +223,10 @@ fn run_prepared<const K: usize, const D: usize>(
                 unconverged_increments: Some(r.unconverged_increments),
                 max_final_residual: Some(r.max_final_residual),
                 stopped_after_peak: r.stopped_after_peak,
+                commits: quasi_static.then(|| r.increments.iter().map(|i| i.commits).sum()),
+                stopped_unconverged: r.stopped_unconverged,
             };
+            increments = r.increments;
             (r.records, r.wall_s, r.failure, report)
         }
     };
@@ -257,6 +264,7 @@ fn run_prepared<const K: usize, const D: usize>(
         }),
         moduli_residual: p.model.random.as_ref().map(|r| r.moduli.residual.clone()),
         records,
+        increments,
         dim: D,
         x0: p.model.particles.x0.iter().map(point3).collect(),
         displacement,

@@ -34,11 +34,13 @@ pub struct Summary {
     pub iterations: Option<usize>,
     /// Relaxation: load increments.
     pub increments: Option<usize>,
-    /// Relaxation: increments that stopped at solver.max_iterations.
+    /// Relaxation: increments that stopped at solver.max_iterations().
     pub unconverged_increments: Option<usize>,
     /// Relaxation: largest out-of-balance force norm / reaction norm at the end of an
     /// increment.
     pub max_final_residual: Option<f64>,
+    /// Quasi-static: state commits (secant iterations) of all increments.
+    pub commits: Option<usize>,
     /// The run stopped after its peak (`loading.stop_after_peak`), before t_end.
     pub stopped_after_peak: bool,
     pub threads: usize,
@@ -124,6 +126,9 @@ pub struct Outcome {
     /// where no fit exists), for the VTK file.
     pub moduli_residual: Option<Vec<f64>>,
     pub records: Vec<Record>,
+    /// How each load increment ended (relaxation and quasi-static runs; empty for the
+    /// explicit solver): `increments.csv`.
+    pub increments: Vec<crate::solver::relaxation::IncrementReport>,
     /// Spatial dimension of the run (2 or 3).
     pub dim: usize,
     pub x0: Vec<[f64; 3]>,
@@ -180,6 +185,10 @@ pub(super) struct SolverReport {
     pub unconverged_increments: Option<usize>,
     pub max_final_residual: Option<f64>,
     pub stopped_after_peak: bool,
+    /// Quasi-static: state commits of all increments.
+    pub commits: Option<usize>,
+    /// Quasi-static: the increment the run stopped at because it did not converge.
+    pub stopped_unconverged: Option<crate::solver::relaxation::IncrementReport>,
 }
 
 /// What a finished run hands to its summary.
@@ -215,10 +224,21 @@ pub(super) fn summarise<const K: usize, const D: usize>(
     let s = &p.model.scene.solver;
     let accepted = s.max_residual.unwrap_or(s.tolerance);
     let unconverged = match (report.unconverged_increments, report.max_final_residual) {
+        _ if report.stopped_unconverged.is_some() => report.stopped_unconverged.map(|inc| format!(
+            "load increment {} of {} (load factor {:.4}) did not converge: after solver.max_iterations = {} iterations and {} state commits its out-of-balance force is {:.3e} × the reactions, above {} = {accepted:e}; the run stopped there, and its curve ends at the last converged increment. Raise solver.max_iterations (a crack that runs at a held displacement needs more iterations), or solver.increments, or accept the residual with solver.max_residual ≥ {:.2e}",
+            inc.increment,
+            report.increments.unwrap_or(0),
+            inc.load_factor,
+            inc.iterations,
+            inc.commits,
+            inc.residual,
+            if s.max_residual.is_some() { "solver.max_residual" } else { "solver.tolerance" },
+            inc.residual,
+        )),
         (Some(k), Some(r)) if k > 0 && r > accepted => Some(format!(
             "{k} of {} load increments stopped at solver.max_iterations = {} with an out-of-balance force up to {r:.3e} × the reactions, above {} = {accepted:e}: the forces and the crack path are not the quasi-static answer. Raise solver.max_iterations or solver.increments, or accept the residual with solver.max_residual ≥ {r:.2e}",
             report.increments.unwrap_or(0),
-            s.max_iterations,
+            s.max_iterations(),
             if s.max_residual.is_some() { "solver.max_residual" } else { "solver.tolerance" },
         )),
         _ => None,
@@ -290,6 +310,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         increments: report.increments,
         unconverged_increments: report.unconverged_increments,
         max_final_residual: report.max_final_residual,
+        commits: report.commits,
         stopped_after_peak: report.stopped_after_peak,
         threads,
         probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),

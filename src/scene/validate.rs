@@ -1001,10 +1001,10 @@ impl Scene {
                 "must satisfy 0 < tolerance < 1 (out-of-balance force norm relative to the largest reaction norm)",
             ));
         }
-        if s.max_iterations == 0 || s.max_iterations > 100_000_000 {
+        if s.max_iterations() == 0 || s.max_iterations() > 100_000_000 {
             return Err(invalid(
                 "solver.max_iterations",
-                s.max_iterations,
+                s.max_iterations(),
                 "an integer from 1 to 100000000 (iterations of one load increment)",
             ));
         }
@@ -1017,11 +1017,11 @@ impl Scene {
                 ));
             }
         }
-        if s.method == SolverMethod::Relaxation && s.force_lag == ForceLag::Previous {
+        if s.method.is_incremental() && s.force_lag == ForceLag::Previous {
             return Err(invalid(
                 "solver.force_lag",
                 "\"previous\"",
-                "\"current\" with solver.method = \"relaxation\" (the relaxation iterates on the forces at the current positions)",
+                format!("\"current\" with solver.method = \"{}\" (the relaxation iterates on the forces at the current positions)", s.method.name()),
             ));
         }
         Ok(())

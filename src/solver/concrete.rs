@@ -70,6 +70,14 @@ pub const fn bytes_per_particle(d: usize, k: usize) -> usize {
     (d * (d + 1) / 2 + 2 + FIELDS) * k * 8 + k + 2 * std::mem::size_of::<ParticleDamage>() + 8
 }
 
+/// The band of elastic stretch |S_e| ≤ 1e-7 (a thousandth of concrete's cracking strain)
+/// within which a held bond keeps its branch at a commit ([`Concrete::frozen`]): where an
+/// equilibrium puts a damaged bond at S_e = 0 its force is set-valued (the tensile and the
+/// compressive damage give different dilatation forces there), and flipping its branch at
+/// every commit would never settle (measured on the tension block after its peak: 2–4 flips
+/// at every commit for 20,000 iterations).
+pub const BRANCH_BAND: f64 = 1e-7;
+
 /// Damage and plasticity of a run: the law, the per-particle geometry the kernel needs, and
 /// the committed and trial state.
 #[derive(Clone, Debug)]
@@ -101,6 +109,21 @@ where
     /// Let both passes run their SIMD blocks where they can (`true`; `false` for tests that
     /// compare them with the scalar path).
     pub simd: bool,
+    /// Keep the committed state through steps (the quasi-static solver's secant iterations:
+    /// pass 1 still computes the trial state at the current positions, and
+    /// [`Concrete::commit`] makes it the committed one between converged states).
+    pub frozen: bool,
+    /// While [`Self::frozen`]: bit k of particle i set where slot k was shortened
+    /// (S_e < 0) at the last commit, so that the held state also holds each bond's branch
+    /// (tensile or compressive damage, [`DamageLaw::bond_factor`]). Without it the force of
+    /// a damaged bond jumps where its stretch changes sign, the held problem has no smooth
+    /// equilibrium, and the iterations chatter about S_e = 0 (measured: the tension block's
+    /// peak increment stuck at 0.7–1.7% out of balance for 20,000 iterations).
+    shortened: Vec<u32>,
+    /// Bits of the slots whose branch flipped at a commit since [`Self::unlock_branches`]:
+    /// a second flip is refused (the bond keeps its branch), so that a bond whose equilibrium
+    /// stretch changes sign with its branch cannot keep the iterations from settling.
+    flipped: Vec<u32>,
 }
 
 /// The criteria (initiation, yield) of a particle read the volume-weighted mean of the damaged
@@ -186,6 +209,9 @@ where
             force_full: false,
             neighbourhood: None,
             simd: true,
+            frozen: false,
+            shortened: Vec::new(),
+            flipped: Vec::new(),
         }
     }
 
@@ -217,6 +243,86 @@ where
         }
         std::mem::swap(&mut self.committed, &mut self.trial);
         std::mem::swap(&mut self.sps, &mut self.sps_trial);
+    }
+
+    /// Hold the committed state, and each bond's branch as it is at positions `x`, through
+    /// the steps that follow (`true`); or commit after every step again (`false`).
+    pub fn freeze(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) {
+        self.frozen = false;
+        if frozen {
+            self.shortened = self.branches(m, x, None);
+        }
+        self.frozen = frozen;
+    }
+
+    /// Commit the trial state of the last step, and take each bond's branch at `x`
+    /// (secant iterations; see [`Self::frozen`]).
+    /// Returns how much the state moved: the largest change of w_t or w_c of a particle,
+    /// and the number of bond ends whose branch changed.
+    pub fn commit_at(&mut self, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) -> (f64, usize) {
+        let law = &self.law;
+        let change = self
+            .committed
+            .par_iter()
+            .zip(self.trial.par_iter())
+            .with_min_len(1024)
+            .map(|(a, b)| {
+                let (a, b) = (law.view(a), law.view(b));
+                (a.wt - b.wt).abs().max((a.wc - b.wc).abs())
+            })
+            .reduce(|| 0.0, f64::max);
+        self.commit();
+        let mut flips = 0;
+        if self.frozen {
+            self.frozen = false;
+            let mut new = self.branches(m, x, Some(&self.shortened));
+            if self.flipped.len() != new.len() {
+                self.flipped = vec![0; new.len()];
+            }
+            for ((n, old), f) in new.iter_mut().zip(&self.shortened).zip(&mut self.flipped) {
+                // a bond that flipped before keeps its branch
+                let change = (*n ^ old) & !*f;
+                *n = old ^ change;
+                *f |= change;
+                flips += change.count_ones() as usize;
+            }
+            self.shortened = new;
+            self.frozen = true;
+        }
+        (change, flips)
+    }
+
+    /// Let every bond flip its branch again (at the start of a load increment).
+    pub fn unlock_branches(&mut self) {
+        self.flipped.iter_mut().for_each(|f| *f = 0);
+    }
+
+    /// The shortened slots of every particle at `x` with the committed plastic stretch. A
+    /// slot whose |S_e| is within [`BRANCH_BAND`] keeps its held branch (`old`, if any).
+    fn branches(
+        &self,
+        m: &Mechanics<D, K>,
+        x: &[SVector<f64, D>],
+        old: Option<&[u32]>,
+    ) -> Vec<u32> {
+        assert!(K <= 32, "the branch bits hold at most 32 slots");
+        (0..m.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|i| {
+                let mut bits = old.map_or(0, |o| o[i]);
+                for k in 0..K {
+                    if let Some(s) = slot::<D, K, L, true>(m, self, x, i, k) {
+                        if s.se < -BRANCH_BAND || (old.is_none() && s.se < 0.0) {
+                            bits |= 1 << k;
+                        } else if s.se > BRANCH_BAND || old.is_none() {
+                            bits &= !(1 << k);
+                        }
+                    }
+                }
+                bits
+            })
+            .collect()
     }
 
     /// Every particle's state as the outputs show it.
@@ -320,9 +426,17 @@ where
     } else {
         st
     };
+    // the branch: the sign of S_e, or the one held at the last commit
+    let branch = if c.frozen && (c.shortened[i] >> k) & 1 == 1 {
+        -1.0
+    } else if c.frozen {
+        1.0
+    } else {
+        se
+    };
     let (d, sd) = c
         .law
-        .bond_factor::<FULL>(&c.committed[i], &c.committed[j], se);
+        .bond_factor::<FULL>(&c.committed[i], &c.committed[j], branch);
     let inv_len = 1.0 / len;
     Some(Slot {
         e: dx * inv_len,
@@ -598,7 +712,8 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
 ) where
     Dim<D>: Dimension<D>,
 {
-    let avx = L::SERIES_DAMAGE && c.simd && use_avx();
+    // the AVX slot loop takes each bond's branch from the sign of S_e
+    let avx = L::SERIES_DAMAGE && c.simd && !c.frozen && use_avx();
     let mut trial = std::mem::replace(&mut c.trial, Aligned::new(0));
     let mut sps_trial = std::mem::replace(&mut c.sps_trial, Aligned::new(0));
     let mut cache = std::mem::replace(&mut c.cache, Aligned::new(0));
@@ -731,7 +846,9 @@ pub fn step<
             );
         }
     });
-    c.commit();
+    if !c.frozen {
+        c.commit();
+    }
 }
 
 /// Internal forces (bonds only, no dampers) at positions x with the committed state; the
@@ -863,6 +980,14 @@ pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
     fn damage(&self) -> Vec<ParticleDamage>;
     /// Whether some particle has failed (w_t or w_c ≥ 0.99).
     fn has_failed_particle(&self) -> bool;
+    /// Hold the committed state through steps (`true`) or commit after every step (`false`,
+    /// the explicit run); see [`Concrete::frozen`].
+    fn set_frozen(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[nalgebra::SVector<f64, D>]);
+    /// Make the trial state of the last step (computed at the positions that step started
+    /// from) the committed one; a held state also takes each bond's branch at `x`.
+    fn commit(&mut self, m: &Mechanics<D, K>, x: &[nalgebra::SVector<f64, D>]) -> (f64, usize);
+    /// Let every held bond change its branch again at a commit (a new load increment).
+    fn unlock_branches(&mut self);
     /// Particle stresses (3.18) at positions x.
     fn particle_stress(
         &self,
@@ -916,6 +1041,15 @@ where
     }
     fn has_failed_particle(&self) -> bool {
         self.committed.iter().any(|s| self.law.view(s).failed())
+    }
+    fn set_frozen(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) {
+        self.freeze(frozen, m, x)
+    }
+    fn commit(&mut self, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) -> (f64, usize) {
+        self.commit_at(m, x)
+    }
+    fn unlock_branches(&mut self) {
+        Concrete::unlock_branches(self)
     }
     fn particle_stress(
         &self,

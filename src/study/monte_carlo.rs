@@ -8,7 +8,7 @@
 //!   `body.size = D`, `discretisation.spacing = s0·min(1, D/D0)` (the same particles per
 //!   width below the scene's size; the scene's spacing, which resolves the material's
 //!   correlation length, above it), every loaded group's displacement scaled by √(D/D0), and,
-//!   with the relaxation solver, `solver.max_iterations` scaled by max(1, D/D0).
+//!   with the relaxation solver, `solver.max_iterations()` scaled by max(1, D/D0).
 //!   - The displacement: the elastic elongation at the peak grows with D, but the crack opening
 //!     needed to fall to `stop_after_peak` × the peak does not (it is a fraction of COD_c), so
 //!     scaling by D/D0 left the small sizes short of it (dog-bone A from the 0.1 mm of D: the
@@ -342,8 +342,8 @@ pub fn size_overrides(base: &Scene, d: f64) -> Vec<String> {
             ));
         }
     }
-    if base.solver.method == crate::scene::SolverMethod::Relaxation {
-        let m = (base.solver.max_iterations as f64 * ratio.max(1.0)).round() as usize;
+    if base.solver.method.is_incremental() {
+        let m = (base.solver.max_iterations() as f64 * ratio.max(1.0)).round() as usize;
         o.push(format!("solver.max_iterations={m}"));
     }
     o
