@@ -40,6 +40,9 @@ pub struct BenchResult {
     pub lattice: String,
     /// Bytes per particle the run's arrays take ([`bytes_per_particle`]).
     pub bytes_per_particle: usize,
+    /// The damage kernels ran their AVX paths where the CPU has them (`false`: `--scalar`,
+    /// the scalar path for a same-binary comparison).
+    pub simd: bool,
     /// Random particles: the seconds their set-up took.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub setup: Option<Setup>,
@@ -108,6 +111,7 @@ pub fn bench(
     kernel: KernelSet,
     layout: Layout,
     lattice: &str,
+    simd: bool,
 ) -> anyhow::Result<BenchResult> {
     anyhow::ensure!(
         layout == Layout::Slots || kernel == KernelSet::Elastic,
@@ -135,7 +139,7 @@ pub fn bench(
             let mm = micro_modulus::hexagonal(30e9, 0.2, l0, 0.1, Plane::Stress);
             p.a = vec![mm.a; n];
             p.b = vec![mm.b; n];
-            time_steps(p, steps, threads, kernel, layout, None)
+            time_steps(p, steps, threads, kernel, layout, None, simd)
         }
         "random" => {
             anyhow::ensure!(
@@ -169,7 +173,7 @@ pub fn bench(
                 bonding_s: g.seconds_bonding,
                 moduli_s: t.elapsed().as_secs_f64(),
             };
-            time_steps(p, steps, threads, kernel, layout, Some(setup))
+            time_steps(p, steps, threads, kernel, layout, Some(setup), simd)
         }
         other => anyhow::bail!("--lattice {other}: \"hexagonal\" or \"random\""),
     }
@@ -207,16 +211,19 @@ fn strained_model<const D: usize, const K: usize>(
 fn damage_model<const D: usize, const K: usize>(
     p: &crate::discretise::Particles<D, K>,
     kernel: KernelSet,
+    simd: bool,
 ) -> anyhow::Result<Option<crate::solver::concrete::Concrete<D, K>>>
 where
     crate::model::dimension::Dim<D>: crate::model::dimension::Dimension<D>,
 {
     let model = (kernel != KernelSet::Elastic).then(|| {
         let law = crate::model::damage::ConcreteLaw::table1(kernel == KernelSet::Full);
-        crate::solver::concrete::Concrete::<D, K>::new(
+        let mut c = crate::solver::concrete::Concrete::<D, K>::new(
             crate::model::two_spring::TwoSpring::new(law, None),
             p,
-        )
+        );
+        c.simd = simd;
+        c
     });
     let chosen = model.as_ref().map_or(KernelSet::Elastic, |c| c.kernel());
     anyhow::ensure!(
@@ -234,11 +241,12 @@ fn time_steps<const K: usize>(
     kernel: KernelSet,
     layout: Layout,
     setup: Option<Setup>,
+    simd: bool,
 ) -> anyhow::Result<BenchResult> {
     let n = p.len();
     let (mech, mut st) = strained_model(&p, kernel);
     let dt = 0.9 * crate::solver::time_step::stable_step(&mech, &p.x0).dt_stable;
-    let mut model = damage_model(&p, kernel)?;
+    let mut model = damage_model(&p, kernel, simd)?;
     let csr = match layout {
         Layout::Csr => Some(Csr::from_slots(&p).map_err(|e| anyhow::anyhow!("CSR bonds: {e}"))?),
         Layout::Slots => None,
@@ -280,6 +288,7 @@ fn time_steps<const K: usize>(
         }
         .into(),
         bytes_per_particle: bytes_per_particle(kernel, 2),
+        simd,
         setup,
     })
 }
@@ -345,6 +354,7 @@ pub fn bench_fcc(
     steps: usize,
     threads: usize,
     kernel: KernelSet,
+    simd: bool,
 ) -> anyhow::Result<BenchResult> {
     let l0 = 1e-3;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -355,7 +365,7 @@ pub fn bench_fcc(
     let (mech, mut st) = strained_model(&p, kernel);
     assert!(mech.second.is_some());
     let dt = 0.9 * pool.install(|| crate::solver::time_step::stable_step(&mech, &p.x0).dt_stable);
-    let mut model = damage_model(&p, kernel)?;
+    let mut model = damage_model(&p, kernel, simd)?;
     drop(p);
     let seconds = timed(&pool, steps, || {
         match model.as_mut() {
@@ -375,6 +385,7 @@ pub fn bench_fcc(
         seconds,
         lattice: "fcc".into(),
         bytes_per_particle: bytes_per_particle(kernel, 3),
+        simd,
         setup: None,
     })
 }

@@ -68,6 +68,10 @@ enum Command {
         /// times of placement, Voronoi cells, bonds and moduli are reported too).
         #[arg(long, default_value = "hexagonal")]
         lattice: String,
+        /// Run the damage kernels' scalar path instead of their AVX blocks (--model tension
+        /// or full), to measure the two in one binary.
+        #[arg(long)]
+        scalar: bool,
     },
     /// Many runs of one scene: lattice objectivity, convergence with the spacing, Monte Carlo
     /// size effect (and the merge of its shards).
@@ -199,6 +203,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             model,
             layout,
             lattice,
+            scalar,
         } => {
             anyhow::ensure!(
                 dim == 2 || dim == 3,
@@ -212,6 +217,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     "--model {model}: \"elastic\", \"tension\" (tensile damage only) or \"full\" (damage and plasticity)"
                 ),
             };
+            anyhow::ensure!(
+                !scalar || kernel != sppm::solver::KernelSet::Elastic,
+                "--scalar: the scalar path of the damage kernels (--model tension or full); the elastic kernel has no switch"
+            );
             let layout = sppm::bench::Layout::parse(&layout).ok_or_else(|| {
                 anyhow::anyhow!("--layout {layout}: \"slots\" or \"csr\" (elastic only)")
             })?;
@@ -246,9 +255,17 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 "--threads {threads}: at most 4096 worker threads"
             );
             let r = if dim == 3 {
-                sppm::bench::bench_fcc(particles, steps.max(1), threads, kernel)
+                sppm::bench::bench_fcc(particles, steps.max(1), threads, kernel, !scalar)
             } else {
-                sppm::bench::bench(particles, steps.max(1), threads, kernel, layout, &lattice)
+                sppm::bench::bench(
+                    particles,
+                    steps.max(1),
+                    threads,
+                    kernel,
+                    layout,
+                    &lattice,
+                    !scalar,
+                )
             }
             .context("benchmark failed")?;
             say!("{}", serde_json::to_string(&r)?);

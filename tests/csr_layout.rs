@@ -284,9 +284,27 @@ fn csr_from_pairs_topology() {
 /// `sppm bench --layout csr` runs the elastic kernel only and says so.
 #[test]
 fn bench_csr_layout_is_elastic_only() {
-    let r = bench(2000, 5, 1, KernelSet::Elastic, Layout::Csr, "hexagonal").unwrap();
+    let r = bench(
+        2000,
+        5,
+        1,
+        KernelSet::Elastic,
+        Layout::Csr,
+        "hexagonal",
+        true,
+    )
+    .unwrap();
     assert_eq!(r.layout, "csr");
-    let e = bench(2000, 5, 1, KernelSet::Tension, Layout::Csr, "hexagonal").unwrap_err();
+    let e = bench(
+        2000,
+        5,
+        1,
+        KernelSet::Tension,
+        Layout::Csr,
+        "hexagonal",
+        true,
+    )
+    .unwrap_err();
     let msg = format!("{e:#}");
     assert!(
         msg.contains("--layout csr") && msg.contains("elastic"),
