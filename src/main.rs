@@ -318,12 +318,22 @@ fn check<const K: usize, const D: usize>(
     say!("time step dt     {:.6e} s", p.dt);
     let threads = rayon::current_num_threads();
     let solver = &sc.solver;
-    if solver.method.is_incremental() {
+    if solver.method == sppm::scene::SolverMethod::QuasiStatic && sc.concrete.is_some() {
+        say!(
+            "solver           quasi_static: {} increments along the ramp (smaller while damage grows), at most {} iterations each (tolerance {:e}); each iteration evaluates the forces, each change of state refactorises the sparse stiffness (docs/quasi_static.md)",
+            solver.increments, solver.max_iterations(), solver.tolerance
+        );
+        say!(
+            "memory (est.)    {:.1} MiB, and the sparse factor",
+            mem / 2f64.powi(20)
+        );
+        say!("run time (est.)  none: it depends on how the crack grows");
+    } else if solver.method.is_incremental() {
         // the iterations per increment are known only once it has converged
         let most = solver.increments * solver.max_iterations();
         say!(
-            "solver           relaxation: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
-            solver.increments, solver.max_iterations(), solver.tolerance
+            "solver           {}: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
+            solver.method.name(), solver.increments, solver.max_iterations(), solver.tolerance
         );
         say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
         say!(

@@ -216,10 +216,17 @@ fn run_prepared<const K: usize, const D: usize>(
                 staggered: quasi_static,
                 stop_unconverged: quasi_static.then(|| s.max_residual.unwrap_or(s.tolerance)),
             };
-            let r = relaxation::relax(&mut sim, probe, &settings, start);
+            // scenes with damage: the implicit secant solver; elastic scenes have no state
+            // to hold, and relax (docs/quasi_static.md)
+            let implicit = quasi_static && sim.inelastic.is_some();
+            let r = if implicit {
+                crate::solver::secant::solve(&mut sim, probe, &settings, start)
+            } else {
+                relaxation::relax(&mut sim, probe, &settings, start)
+            };
             let report = SolverReport {
                 iterations: Some(r.iterations),
-                increments: Some(s.increments),
+                increments: Some(r.increments.len().max(s.increments)),
                 unconverged_increments: Some(r.unconverged_increments),
                 max_final_residual: Some(r.max_final_residual),
                 stopped_after_peak: r.stopped_after_peak,

@@ -10,6 +10,7 @@ pub mod loading;
 pub mod mechanics;
 pub mod modal;
 pub mod relaxation;
+pub mod secant;
 pub mod time_step;
 
 /// Deterministic pseudo-random numbers for the kernels' unit tests.
