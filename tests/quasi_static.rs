@@ -8,19 +8,7 @@
 mod common;
 use common::says;
 use common::*;
-use sppm::run::RunOptions;
 use sppm::Scene;
-
-fn run(s: &Scene, threads: usize) -> sppm::Outcome {
-    sppm::run(
-        s,
-        &RunOptions {
-            progress: false,
-            threads: Some(threads),
-        },
-    )
-    .unwrap()
-}
 
 /// The 100 mm tension block of tests/relaxation.rs: every increment converges (the implicit
 /// secant solver) to a residual below the tolerance, the block cracks through and dissipates

@@ -7,19 +7,8 @@
 mod common;
 use common::says;
 use common::*;
-use sppm::run::{prepare_model, RunOptions};
+use sppm::run::prepare_model;
 use sppm::Scene;
-
-fn run(s: &Scene, threads: usize) -> sppm::Outcome {
-    sppm::run(
-        s,
-        &RunOptions {
-            progress: false,
-            threads: Some(threads),
-        },
-    )
-    .unwrap()
-}
 
 /// The plate of tests/run_plate.rs (L0 = 4 mm, ε = 1e-4) under relaxation.
 fn plate(settings: &[&str]) -> Scene {

@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use sppm::run::{prepare_model, RunOptions};
+use sppm::run::prepare_model;
 
 fn plate(lag: &str) -> sppm::Scene {
     let mut text = plate_toml(0.1, 0.2, 0.004, 0.0, "stress", false, 0.2);
@@ -13,17 +13,6 @@ fn plate(lag: &str) -> sppm::Scene {
         "[solver]\nforce_lag = \"{lag}\"\n[output]\nmap = false\nvtk = false\n"
     ));
     scene(&text)
-}
-
-fn run(s: &sppm::Scene, threads: usize) -> sppm::Outcome {
-    sppm::run(
-        s,
-        &RunOptions {
-            progress: false,
-            threads: Some(threads),
-        },
-    )
-    .unwrap()
 }
 
 #[test]

@@ -213,7 +213,6 @@ fn run_prepared<const K: usize, const D: usize>(
                 max_iterations: s.max_iterations(),
                 ramp: p.model.scene.loading.ramp,
                 stop_after_peak: p.model.scene.loading.stop_after_peak,
-                staggered: quasi_static,
                 stop_unconverged: quasi_static.then(|| s.max_residual.unwrap_or(s.tolerance)),
             };
             // scenes with damage: the implicit secant solver; elastic scenes have no state

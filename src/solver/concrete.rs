@@ -248,9 +248,12 @@ where
     /// Hold the committed state, and each bond's branch as it is at positions `x`, through
     /// the steps that follow (`true`); or commit after every step again (`false`).
     pub fn freeze(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) {
+        // (the branches are read from S_e, which the held branch does not change; the held
+        // bits are read only while frozen, so none are needed to compute the first ones)
         self.frozen = false;
         if frozen {
             self.shortened = self.branches(m, x, None);
+            self.flipped = vec![0; m.len()];
         }
         self.frozen = frozen;
     }
@@ -274,11 +277,7 @@ where
         self.commit();
         let mut flips = 0;
         if self.frozen {
-            self.frozen = false;
             let mut new = self.branches(m, x, Some(&self.shortened));
-            if self.flipped.len() != new.len() {
-                self.flipped = vec![0; new.len()];
-            }
             for ((n, old), f) in new.iter_mut().zip(&self.shortened).zip(&mut self.flipped) {
                 // a bond that flipped before keeps its branch
                 let change = (*n ^ old) & !*f;
@@ -287,7 +286,6 @@ where
                 flips += change.count_ones() as usize;
             }
             self.shortened = new;
-            self.frozen = true;
         }
         (change, flips)
     }

@@ -92,6 +92,18 @@ pub struct Probe {
     pub amplitude: f64,
 }
 
+impl Probe {
+    /// The reaction of the group along its component: −Σ of the internal forces `f` on its
+    /// members.
+    pub fn reaction<const D: usize>(&self, f: &[SVector<f64, D>]) -> f64 {
+        -self
+            .members
+            .iter()
+            .map(|&i| f[i as usize][self.component])
+            .sum::<f64>()
+    }
+}
+
 /// Stops a run once it has passed its peak (`loading.stop_after_peak`): the probe force,
 /// taken along the loading direction, has fallen below `fraction` × its largest value, and
 /// (explicit runs) a particle has failed. The failed particle keeps the early ramp of an
@@ -396,11 +408,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 step: self.step,
                 time_s: t,
                 displacement_m: probe.amplitude * r_now,
-                force_n: -probe
-                    .members
-                    .iter()
-                    .map(|&i| self.state.force[i as usize][probe.component])
-                    .sum::<f64>(),
+                force_n: probe.reaction(&self.state.force),
                 kinetic_j: kinetic,
                 internal_j: self.internal_energy_now(),
                 external_work_j: self.external_work + work_half,

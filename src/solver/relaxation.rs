@@ -52,19 +52,6 @@ use std::time::Instant;
 /// depend on the thread count).
 const CHUNK: usize = 2048;
 
-/// Secant iterations: the state is committed at every equilibrium within COMMIT_FACTOR ×
-/// the tolerance. Measured: 10 took 30,680 iterations on the tension scene against 58,176
-/// for 1 with the same peak, but on the 100 mm tension block of tests/relaxation.rs it
-/// committed every few iterations while a crack crept (9,469 commits in one increment) and
-/// did not converge; 1 dissipated 1.015 × G_f·A there.
-const COMMIT_FACTOR: f64 = 1.0;
-
-/// Secant iterations: an increment has converged only at a commit that changes no
-/// particle's w_t or w_c by more than this (and flips no bond's branch): a change of 1e-3
-/// in one particle's damage moves the forces by about 1e-3 of one particle's share of the
-/// section's force, below the force tolerance of any shipped scene.
-const STATE_TOLERANCE: f64 = 1e-3;
-
 /// The relaxation keys of a scene (`[solver]`).
 #[derive(Clone, Copy, Debug)]
 pub struct Settings {
@@ -74,10 +61,6 @@ pub struct Settings {
     pub ramp: Ramp,
     /// `loading.stop_after_peak` (see [`PeakStop`]).
     pub stop_after_peak: Option<f64>,
-    /// Secant iterations (`solver.method = "quasi_static"`): the damage and plastic state is
-    /// held while the positions relax and committed only at an equilibrium; an increment has
-    /// converged when an equilibrium is also consistent with its state (see [`relax`]).
-    pub staggered: bool,
     /// Stop at the first increment that ends above this out-of-balance ratio (quasi-static
     /// runs: `solver.max_residual`, else `tolerance`); `None` runs on (the relaxation).
     pub stop_unconverged: Option<f64>,
@@ -92,7 +75,7 @@ pub struct IncrementReport {
     pub load_factor: f64,
     /// Kernel steps of the increment.
     pub iterations: usize,
-    /// State commits of the increment (secant iterations; 0 for the relaxation).
+    /// State commits of the increment (`solver::secant`; 0 for the relaxation).
     pub commits: usize,
     /// ‖F_free‖₂ / ‖R‖₂ at its end.
     pub residual: f64,
@@ -169,12 +152,6 @@ struct AdaptiveDamping<const D: usize> {
     c: f64,
     /// The state was moved outside the kernel: the next update keeps c.
     restart: bool,
-    /// Keep c where the quotient is not positive (secant iterations) instead of Kilic &
-    /// Madenci's c = 0: near a held equilibrium with damaged bonds the local stiffness
-    /// estimates are noise, the quotient changes sign from step to step, and with c = 0 for
-    /// hundreds of steps at a time the relaxation never settled (measured on dog-bone B: one
-    /// increment 1.0e-2 out of balance after 20,000 iterations).
-    keep_c: bool,
 }
 
 impl<const D: usize> AdaptiveDamping<D> {
@@ -190,7 +167,6 @@ impl<const D: usize> AdaptiveDamping<D> {
             partial: vec![Norms::default(); n.div_ceil(CHUNK)],
             c: 0.0,
             restart: false,
-            keep_c: false,
         }
     }
 
@@ -234,8 +210,6 @@ impl<const D: usize> AdaptiveDamping<D> {
         }
         self.c = if total.rayleigh_num > 0.0 && total.rayleigh_den > 0.0 {
             (2.0 * (total.rayleigh_num / total.rayleigh_den).sqrt()).min(2.0 / dt)
-        } else if self.keep_c {
-            self.c
         } else {
             0.0
         };
@@ -345,15 +319,8 @@ fn reaction_work<const D: usize, const K: usize>(
 /// Stops early, with `failure` set, if the state blows up, and with `stopped_unconverged`
 /// set at the first increment above [`Settings::stop_unconverged`].
 ///
-/// **Secant iterations** ([`Settings::staggered`]): the state (damage, plastic stretch) is
-/// held while the pseudo-dynamics relaxes the positions, so each relaxation solves an elastic
-/// (secant) problem, which has an equilibrium and to which the adaptive damper converges. At
-/// that equilibrium the state the kernel computed from the positions (pass 1's trial state) is
-/// committed, and the relaxation goes on from there. The increment has converged when the step
-/// right after a commit still meets the tolerance: the positions are in equilibrium with a
-/// state that is consistent with them. Damage then grows only through equilibrium states,
-/// never through the overshoot of an iteration, and a crack that runs at a held displacement
-/// (a snap-back) runs through a sequence of equilibria inside one increment.
+/// (The same pseudo-dynamics with the state held and committed at its equilibria was measured
+/// as the quasi-static solver's first design and dropped: docs/quasi_static.md.)
 pub fn relax<const D: usize, const K: usize>(
     sim: &mut Simulation<D, K>,
     probe: &Probe,
@@ -361,13 +328,8 @@ pub fn relax<const D: usize, const K: usize>(
     start: Instant,
 ) -> Relaxed {
     let mut damping = AdaptiveDamping::new(sim);
-    damping.keep_c = s.staggered;
     let mut predictor = Predictor::new(sim.x0.len());
     let mut stop = PeakStop::quasi_static(s.stop_after_peak, probe);
-    let staggered = s.staggered && sim.inelastic.is_some();
-    if let Some(model) = sim.inelastic.as_mut() {
-        model.set_frozen(staggered, &sim.mech, &sim.state.x);
-    }
     let mut r_prev = 0.0;
     let mut out = Relaxed {
         records: Vec::with_capacity(s.increments + 1),
@@ -378,7 +340,6 @@ pub fn relax<const D: usize, const K: usize>(
     // Largest reaction norm² of the converged increments so far.
     let mut converged_reaction2: f64 = 0.0;
     let tol2 = s.tolerance * s.tolerance;
-    let commit_tol2 = tol2 * COMMIT_FACTOR * COMMIT_FACTOR;
     'increments: for k in 1..=s.increments {
         let factor = ramp_fraction(s.ramp, k as f64 / s.increments as f64, 1.0);
         // The step that records the converged state of increment k − 1 also moves the
@@ -409,10 +370,6 @@ pub fn relax<const D: usize, const K: usize>(
             load_factor: factor,
             ..Default::default()
         };
-        let mut last_commit = 0;
-        if let Some(model) = sim.inelastic.as_mut() {
-            model.unlock_branches();
-        }
         loop {
             sim.advance(None);
             report.iterations += 1;
@@ -422,32 +379,10 @@ pub fn relax<const D: usize, const K: usize>(
                 sim.add_external_work(u_predicted - u_converged - booked);
             }
             let scale = norms.reaction2.max(converged_reaction2);
-            let balanced = norms.residual2 <= tol2 * scale;
             if scale > 0.0 {
                 report.residual = (norms.residual2 / scale).sqrt();
             }
-            // Secant iterations: commit the state at every equilibrium of the looser commit
-            // tolerance; the increment has converged at an equilibrium of the tolerance at
-            // which the commit moves no particle's damage by more than STATE_TOLERANCE and
-            // flips no bond's branch.
-            let mut settled = !staggered;
-            if staggered
-                && norms.residual2 <= commit_tol2 * scale
-                && report.iterations > last_commit + 1
-            {
-                let (dw, flips) = match sim.inelastic.as_mut() {
-                    Some(model) => model.commit(&sim.mech, &sim.state.x),
-                    None => (0.0, 0),
-                };
-                report.commits += 1;
-                last_commit = report.iterations;
-                settled = balanced && dw <= STATE_TOLERANCE && flips == 0;
-                // The forces jump with the state: no stiffness estimate across the jump.
-                if dw > 0.0 || flips > 0 {
-                    damping.restart = true;
-                }
-            }
-            let converged = balanced && settled;
+            let converged = norms.residual2 <= tol2 * scale;
             if converged || report.iterations >= s.max_iterations {
                 report.converged = converged;
                 if converged {
@@ -485,9 +420,6 @@ pub fn relax<const D: usize, const K: usize>(
         out.records.extend(rec);
         out.wall_s.push(start.elapsed().as_secs_f64());
         out.iterations += 1;
-    }
-    if let Some(model) = sim.inelastic.as_mut() {
-        model.set_frozen(false, &sim.mech, &sim.state.x);
     }
     out
 }

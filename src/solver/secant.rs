@@ -231,11 +231,7 @@ pub fn solve<const D: usize, const K: usize>(
             step: iterations,
             time_s: r,
             displacement_m: probe.amplitude * r,
-            force_n: -probe
-                .members
-                .iter()
-                .map(|&i| f[i as usize][probe.component])
-                .sum::<f64>(),
+            force_n: probe.reaction(f),
             kinetic_j: 0.0,
             internal_j: sim.internal_energy_now(),
             external_work_j: work,
@@ -266,11 +262,7 @@ pub fn solve<const D: usize, const K: usize>(
         for i in 0..n {
             for c in 0..D {
                 if dofs.column[D * i + c] != usize::MAX {
-                    let u = if r1 > 0.0 && r2 == 0.0 && k == 2 {
-                        u1[i][c] * r / r1
-                    } else {
-                        u1[i][c] + alpha * (u1[i][c] - u2[i][c])
-                    };
+                    let u = u1[i][c] + alpha * (u1[i][c] - u2[i][c]);
                     sim.state.x[i][c] = sim.x0[i][c] + u;
                 }
             }

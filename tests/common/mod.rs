@@ -311,3 +311,15 @@ pub fn says(msg: &str, fragments: &[&str]) {
         assert!(msg.contains(f), "message {msg:?} does not name {f:?}");
     }
 }
+
+/// Run a scene on `threads` threads without a progress bar (it must succeed).
+pub fn run(s: &sppm::Scene, threads: usize) -> sppm::Outcome {
+    sppm::run(
+        s,
+        &sppm::run::RunOptions {
+            progress: false,
+            threads: Some(threads),
+        },
+    )
+    .unwrap()
+}
