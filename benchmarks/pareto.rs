@@ -4,7 +4,9 @@
 //!
 //! Sweeps the lattice spacing, the time-step safety factor, the loading time (fundamental
 //! periods), internal and external damping one at a time around the scene's values, plus
-//! coarse-and-fast combinations. The runs go one after another, each on `--threads` threads,
+//! coarse-and-fast combinations; and the quasi-static solver (`solver.method = "quasi_static"`,
+//! issue 16) at ½, 1, 2 and 4 × the scene's load increments and at spacings ×2, ×1.5 and
+//! ×0.7. The reference comes from the explicit runs alone. The runs go one after another, each on `--threads` threads,
 //! so that their wall times compare. Each finished run is appended to `runs.csv` at once; a
 //! second invocation skips the runs already there. Wall times include the set-up (lattice,
 //! fundamental period, stable step). Then the error of each run (deviation of
@@ -66,6 +68,27 @@ fn variants(scene: &Scene) -> anyhow::Result<Vec<(String, &'static str, Vec<Stri
                 vec![format!("damping.external={x}")],
             ));
         }
+    }
+    let qs = "solver.method=quasi_static".to_string();
+    let n = scene.solver.increments;
+    for f in [1, 2, 4] {
+        v.push((
+            format!("quasi_static,increments={}", n * f),
+            "quasi_static",
+            vec![qs.clone(), format!("solver.increments={}", n * f)],
+        ));
+    }
+    v.push((
+        format!("quasi_static,increments={}", n / 2),
+        "quasi_static",
+        vec![qs.clone(), format!("solver.increments={}", n / 2)],
+    ));
+    for f in [2.0, 1.5, 0.7] {
+        v.push((
+            format!("quasi_static,spacing={:.4}", h * f),
+            "quasi_static_spacing",
+            vec![qs.clone(), format!("discretisation.spacing={}", h * f)],
+        ));
     }
     for (fh, fp) in [(2.0, 0.25), (2.0, 0.5), (1.5, 0.25), (1.5, 0.5), (0.7, 0.5)] {
         v.push((
@@ -174,6 +197,8 @@ fn main() -> anyhow::Result<()> {
             wall_time_s,
             peak_force_n: s.peak_force_n,
             status: s.status.clone(),
+            method: s.solver_method.name().to_string(),
+            increments: s.increments,
         };
         println!(
             "{label:<40} {:>8} particles {:>8.2} s  peak {:.5e} N  {}",
@@ -203,14 +228,16 @@ fn main() -> anyhow::Result<()> {
     let mut f = std::fs::File::create(dir.join("pareto.csv"))?;
     writeln!(
         f,
-        "label,parameter,spacing_m,end_periods,safety,internal_damping,external_damping,particles,steps,wall_time_s,peak_force_N,error,on_front"
+        "label,parameter,method,increments,spacing_m,end_periods,safety,internal_damping,external_damping,particles,steps,wall_time_s,peak_force_N,error,on_front"
     )?;
     for (i, x) in ok.iter().enumerate() {
         writeln!(
             f,
-            "\"{}\",{},{},{},{},{},{},{},{},{:.4},{:.6e},{:.6e},{}",
+            "\"{}\",{},{},{},{},{},{},{},{},{},{},{:.4},{:.6e},{:.6e},{}",
             x.label,
             x.parameter,
+            x.method,
+            x.increments.map(|n| n.to_string()).unwrap_or_default(),
             x.spacing_m,
             x.end_periods,
             x.safety,
@@ -308,6 +335,8 @@ fn plot(
         "internal_damping",
         "external_damping",
         "combined",
+        "quasi_static",
+        "quasi_static_spacing",
     ];
     for (k, p) in params.iter().enumerate() {
         let c = Palette99::pick(k).to_rgba();

@@ -4,6 +4,10 @@
 # peak force, the force at equal displacement down the softening branch to 30% of the
 # peak, the dissipated energy, and the wall time to the peak. Reference: the explicit run
 # loaded 4× more slowly (loading.end_periods × 4) at solver.safety = 0.5 ("ref").
+# Two energy ratios: W_d/ref compares the summaries' dissipated_energy_J (W − U − K − the
+# dampers' energy); W-U/ref compares W − U − K, which counts what the explicit run's dampers
+# absorbed as lost too (a quasi-static solver has no dampers: the energy a snap releases is
+# in its W − U).
 #
 # Each run writes its own folder under $OUT and is skipped when its summary.json exists, so
 # an interrupted comparison resumes where it stopped. One simulation at a time (the timings).
@@ -85,7 +89,7 @@ def softening_error(curve, ref):
     return worst
 
 print(f'{"scene":<22} {"method":<13} {"to peak s":>9} {"total s":>8} {"peak kN":>9} {"ref kN":>9} '
-      f'{"peak err %":>10} {"soft err %":>10} {"W_d J":>8} {"W_d/ref":>8} {"unconv":>6}')
+      f'{"peak err %":>10} {"soft err %":>10} {"W_d J":>8} {"W_d/ref":>8} {"W-U/ref":>8} {"unconv":>6}')
 for n in sys.argv[2:]:
     r, rc = load(n, "reference")
     for m in ("explicit", "relaxation", "quasi_static"):
@@ -97,8 +101,11 @@ for n in sys.argv[2:]:
         rp = r["peak_force_N"] if r else float("nan")
         soft = 100 * softening_error(c, rc) if r else float("nan")
         wr = s["dissipated_energy_J"] / r["dissipated_energy_J"] if r else float("nan")
+        # W − U − K: the dissipated energy with the dampers' share, the whole irrecoverable work
+        lost = lambda x: x["dissipated_energy_J"] + x.get("damping_energy_J", 0.0)
+        lr = lost(s) / lost(r) if r else float("nan")
         un = s.get("unconverged_increments")
         print(f'{n:<22} {m:<13} {s["wall_time_to_peak_s"]:9.3f} {s["wall_time_s"]:8.2f} {pk/1e3:9.3f} '
-              f'{rp/1e3:9.3f} {100*(pk/rp-1):10.2f} {soft:10.2f} {s["dissipated_energy_J"]:8.3f} {wr:8.3f} '
+              f'{rp/1e3:9.3f} {100*(pk/rp-1):10.2f} {soft:10.2f} {s["dissipated_energy_J"]:8.3f} {wr:8.3f} {lr:8.3f} '
               f'{"" if un is None else un:>6}  {s["status"]}')
 PY

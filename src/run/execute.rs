@@ -230,6 +230,7 @@ fn run_prepared<const K: usize, const D: usize>(
                 max_final_residual: Some(r.max_final_residual),
                 stopped_after_peak: r.stopped_after_peak,
                 commits: quasi_static.then(|| r.increments.iter().map(|i| i.commits).sum()),
+                factorisations: implicit.then_some(r.factorisations),
                 stopped_unconverged: r.stopped_unconverged,
             };
             increments = r.increments;

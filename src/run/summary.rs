@@ -41,6 +41,9 @@ pub struct Summary {
     pub max_final_residual: Option<f64>,
     /// Quasi-static: state commits (secant iterations) of all increments.
     pub commits: Option<usize>,
+    /// Quasi-static with damage: Cholesky factorisations of the held stiffness (the Newton
+    /// steps between them are solved by conjugate gradients preconditioned with the last).
+    pub factorisations: Option<usize>,
     /// The run stopped after its peak (`loading.stop_after_peak`), before t_end.
     pub stopped_after_peak: bool,
     pub threads: usize,
@@ -187,6 +190,8 @@ pub(super) struct SolverReport {
     pub stopped_after_peak: bool,
     /// Quasi-static: state commits of all increments.
     pub commits: Option<usize>,
+    /// Quasi-static with damage: Cholesky factorisations.
+    pub factorisations: Option<usize>,
     /// Quasi-static: the increment the run stopped at because it did not converge.
     pub stopped_unconverged: Option<crate::solver::relaxation::IncrementReport>,
 }
@@ -311,6 +316,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         unconverged_increments: report.unconverged_increments,
         max_final_residual: report.max_final_residual,
         commits: report.commits,
+        factorisations: report.factorisations,
         stopped_after_peak: report.stopped_after_peak,
         threads,
         probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),

@@ -104,6 +104,8 @@ pub struct Relaxed {
     /// The increment the run stopped at because it did not converge
     /// ([`Settings::stop_unconverged`]).
     pub stopped_unconverged: Option<IncrementReport>,
+    /// Cholesky factorisations of the held stiffness (`solver::secant`; 0 here).
+    pub factorisations: usize,
 }
 
 /// Switch the dampers off and compute the stable limit of the undamped model.

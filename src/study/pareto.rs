@@ -27,6 +27,16 @@ pub struct SweepRun {
     #[serde(rename = "peak_force_N")]
     pub peak_force_n: f64,
     pub status: String,
+    /// The solver (`solver.method`); runs.csv files written before issue 16 lack it.
+    #[serde(default = "explicit")]
+    pub method: String,
+    /// Load increments of the relaxation and quasi-static solvers.
+    #[serde(default)]
+    pub increments: Option<usize>,
+}
+
+fn explicit() -> String {
+    "explicit".into()
 }
 
 /// The converged reference peak load and how it was composed.
@@ -152,6 +162,8 @@ mod tests {
             wall_time_s: 1.0,
             peak_force_n: peak,
             status: "completed".into(),
+            method: "explicit".into(),
+            increments: None,
         };
         let f = |h: f64| 100.0 + 2.0e4 * h * h;
         let runs = vec![
@@ -164,6 +176,9 @@ mod tests {
             run("end_periods", 0.01, 20.0, 0.9, f(0.01) + 9.0),
             run("safety", 0.01, 80.0, 0.5, f(0.01) + 0.25),
             run("safety", 0.01, 80.0, 0.97, f(0.01) + 3.0),
+            // the quasi-static solver's runs are measured against the reference, not part of it
+            run("quasi_static", 0.01, 80.0, 0.9, 50.0),
+            run("quasi_static_spacing", 0.001, 80.0, 0.9, 50.0),
         ];
         let r = reference(&runs).unwrap();
         // the three finest spacings, order 2; the longest loading; the smallest safety factor
