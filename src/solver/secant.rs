@@ -9,10 +9,8 @@
 //! being the kernel's own force; the stiffness leaves out only the geometric term, so a few
 //! iterations reach the tolerance. At that equilibrium the state computed there is
 //! committed; the increment has converged when a commit moves no particle's damage by more
-//! than [`STATE_TOLERANCE`] and flips no bond's branch. The stiffness is reassembled after
-//! every commit that changed the state; each Newton step is solved by conjugate gradients
-//! preconditioned with the last Cholesky factor ([`pcg`]), and the stiffness is factorised
-//! anew only where they take more than [`CG_MAX`] iterations.
+//! than [`STATE_TOLERANCE`] and flips no bond's branch. The stiffness is refactorised after
+//! every commit that changed the state.
 //!
 //! There is no pseudo-dynamics and no damper: the work of the prescribed displacements is
 //! booked by the trapezoid rule with the converged reactions, so the dissipated energy of
@@ -31,18 +29,9 @@ use std::time::Instant;
 /// more than this and flips no bond's branch (as the relaxation's secant iterations).
 pub const STATE_TOLERANCE: f64 = 1e-3;
 
-/// Newton iterations on one held state before the stiffness is reassembled at the current
+/// Newton iterations on one held state before the stiffness is refactorised at the current
 /// positions.
-const NEWTON_PER_ASSEMBLY: usize = 8;
-
-/// Each Newton step solves K·Δx = F to this fraction of ‖F‖ by conjugate gradients
-/// preconditioned with the last Cholesky factor ([`pcg`]), kept across commits and
-/// increments; where that takes more than CG_MAX iterations, K is factorised anew.
-/// Measured (quasi-static dog-bone B and D, one session, against refactorising after every
-/// commit): CG_MAX = 4 took 0.44× and 0.64× the wall time, CG_MAX = 25 0.83× and 1.00×
-/// (the stale factor's solves then cost more than the factorisations they save).
-const CG_TOLERANCE: f64 = 1e-3;
-const CG_MAX: usize = 4;
+const NEWTON_PER_FACTOR: usize = 8;
 
 /// The regularisation of the stiffness's diagonal, relative to its largest entry: a particle
 /// whose every bond is broken has no stiffness, and holds its position.
@@ -108,11 +97,10 @@ struct Pattern {
     values: Vec<f64>,
 }
 
-/// The held stiffness of the free degrees of freedom, assembled: the symmetric part of
-/// `concrete::secant_stiffness`, its diagonal regularised.
-struct Stiffness(SparseColMat<usize, f64>);
+/// A factorised stiffness of the free degrees of freedom.
+struct Factor(Llt<usize, f64>);
 
-impl Stiffness {
+impl Factor {
     fn new<const D: usize, const K: usize>(
         sim: &Simulation<D, K>,
         dofs: &Dofs,
@@ -164,104 +152,19 @@ impl Stiffness {
         let eps = REGULARISATION * largest.max(f64::MIN_POSITIVE);
         let base = 2 * p.keep.len();
         p.values[base..].iter_mut().for_each(|v| *v = eps);
-        SparseColMat::<usize, f64>::new_from_argsort(p.symbolic.clone(), &p.argsort, &p.values)
-            .map(Stiffness)
-            .map_err(|e| format!("the stiffness could not be assembled: {e:?}"))
+        let a =
+            SparseColMat::<usize, f64>::new_from_argsort(p.symbolic.clone(), &p.argsort, &p.values)
+                .map_err(|e| format!("the stiffness could not be assembled: {e:?}"))?;
+        let llt = Llt::try_new_with_symbolic(p.llt.clone(), a.as_ref(), Side::Lower)
+            .map_err(|e| format!("the secant stiffness is not positive definite ({e:?})"))?;
+        Ok(Factor(llt))
     }
 
-    /// Its Cholesky factor, with the symbolic factorisation of the pattern.
-    fn factor(&self, pattern: &Pattern) -> Result<Factor, String> {
-        Llt::try_new_with_symbolic(pattern.llt.clone(), self.0.as_ref(), Side::Lower)
-            .map(Factor)
-            .map_err(|e| format!("the secant stiffness is not positive definite ({e:?})"))
-    }
-
-    /// y = K·x.
-    fn apply(&self, x: &[f64], y: &mut [f64]) {
-        let a = self.0.as_ref();
-        for (j, &xj) in x.iter().enumerate() {
-            for (r, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
-                y[r] += v * xj;
-            }
-        }
-    }
-}
-
-/// A factorised stiffness of the free degrees of freedom.
-struct Factor(Llt<usize, f64>);
-
-impl Factor {
-    /// x ← K_f⁻¹·x, K_f the stiffness it was factorised from.
-    fn solve(&self, x: &mut [f64]) {
+    fn solve(&self, rhs: &mut faer::Mat<f64>) {
         use faer::linalg::solvers::SolveCore;
-        let n = x.len();
-        let m = faer::MatMut::from_column_major_slice_mut(x, n, 1);
-        self.0.solve_in_place_with_conj(faer::Conj::No, m);
+        self.0
+            .solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
     }
-}
-
-/// Scratch vectors of the preconditioned conjugate gradients.
-#[derive(Default)]
-struct Cg {
-    r: Vec<f64>,
-    z: Vec<f64>,
-    p: Vec<f64>,
-    q: Vec<f64>,
-}
-
-/// Solve K·x = b by conjugate gradients preconditioned with the factor of an earlier held
-/// stiffness (after a commit the state differs at a few particles, so the factor of the
-/// stiffness before it is nearly K's inverse). Returns the iterations taken, or None when
-/// they reach [`CG_MAX`] before the preconditioned residual (r·M⁻¹r)^½ falls to
-/// [`CG_TOLERANCE`] of b's, or K·p has no positive curvature: then the caller factorises K itself.
-fn pcg(k: &Stiffness, m: &Factor, b: &[f64], x: &mut [f64], cg: &mut Cg) -> Option<usize> {
-    let n = b.len();
-    for v in [&mut cg.r, &mut cg.z, &mut cg.p, &mut cg.q] {
-        v.clear();
-        v.resize(n, 0.0);
-    }
-    x.iter_mut().for_each(|v| *v = 0.0);
-    cg.r.copy_from_slice(b);
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
-    cg.z.copy_from_slice(&cg.r);
-    m.solve(&mut cg.z);
-    cg.p.copy_from_slice(&cg.z);
-    let mut rz = dot(&cg.r, &cg.z);
-    // the preconditioned residual r·M⁻¹r, which weighs the soft modes (pieces held only by
-    // the regularisation) as the error in x does; ‖r‖ alone would accept large moves there
-    let stop = CG_TOLERANCE * CG_TOLERANCE * rz;
-    if rz.is_nan() || rz <= 0.0 {
-        return if rz == 0.0 { Some(0) } else { None };
-    }
-    for it in 1..=CG_MAX {
-        cg.q.iter_mut().for_each(|v| *v = 0.0);
-        k.apply(&cg.p, &mut cg.q);
-        let pq = dot(&cg.p, &cg.q);
-        if pq.is_nan() || pq <= 0.0 {
-            return None;
-        }
-        let alpha = rz / pq;
-        for ((xi, ri), (pi, qi)) in x
-            .iter_mut()
-            .zip(cg.r.iter_mut())
-            .zip(cg.p.iter().zip(&cg.q))
-        {
-            *xi += alpha * pi;
-            *ri -= alpha * qi;
-        }
-        cg.z.copy_from_slice(&cg.r);
-        m.solve(&mut cg.z);
-        let rz_new = dot(&cg.r, &cg.z);
-        if rz_new <= stop {
-            return Some(it);
-        }
-        let beta = rz_new / rz;
-        rz = rz_new;
-        for (pi, zi) in cg.p.iter_mut().zip(&cg.z) {
-            *pi = zi + beta * *pi;
-        }
-    }
-    None
 }
 
 /// The out-of-balance force on the free components and the reactions, squared norms.
@@ -318,17 +221,6 @@ pub fn solve<const D: usize, const K: usize>(
     let mut converged_reaction2: f64 = 0.0;
     let mut iterations = 0usize;
     let mut pattern: Option<Pattern> = None;
-    // the preconditioner: the last factorised stiffness, kept across commits and increments
-    let mut factor: Option<Factor> = None;
-    let (mut rhs, mut dx) = (vec![0.0; dofs.count], vec![0.0; dofs.count]);
-    let mut cg = Cg::default();
-    let fail = |step: usize, time: f64, what: String| super::Unstable {
-        step,
-        time,
-        particle: 0,
-        position: String::new(),
-        what,
-    };
     let record = |sim: &Simulation<D, K>,
                   f: &[SVector<f64, D>],
                   r: f64,
@@ -387,8 +279,8 @@ pub fn solve<const D: usize, const K: usize>(
             load_factor: r,
             ..Default::default()
         };
-        let mut stiffness: Option<Stiffness> = None;
-        let mut since_assembly = 0;
+        let mut factor: Option<Factor> = None;
+        let mut since_factor = 0;
         let mut since_commit = 0;
         let mut growth: f64 = 0.0;
         let forces = loop {
@@ -400,7 +292,10 @@ pub fn solve<const D: usize, const K: usize>(
             report.iterations += 1;
             let (free2, reaction2) = norms(&f, &dofs);
             let scale = reaction2.max(converged_reaction2);
-            report.residual = if scale > 0.0 {
+            report.residual = if !(free2 + reaction2).is_finite() {
+                // a non-finite force anywhere ends the increment unconverged
+                f64::NAN
+            } else if scale > 0.0 {
                 (free2 / scale).sqrt()
             } else {
                 0.0
@@ -427,52 +322,46 @@ pub fn solve<const D: usize, const K: usize>(
                     converged_reaction2 = converged_reaction2.max(reaction2);
                     break f;
                 }
-                stiffness = None;
+                factor = None;
             }
             if report.iterations >= s.max_iterations {
                 report.converged = false;
                 break f;
             }
-            if stiffness.is_none() || since_assembly >= NEWTON_PER_ASSEMBLY {
-                match Stiffness::new(sim, &dofs, &mut pattern) {
-                    Ok(k) => stiffness = Some(k),
+            if factor.is_none() || since_factor >= NEWTON_PER_FACTOR {
+                match Factor::new(sim, &dofs, &mut pattern) {
+                    Ok(fa) => {
+                        factor = Some(fa);
+                        out.factorisations += 1;
+                    }
                     Err(e) => {
-                        out.failure = Some(fail(iterations + report.iterations, r, e));
+                        out.failure = Some(super::Unstable {
+                            step: iterations + report.iterations,
+                            time: r,
+                            particle: 0,
+                            position: String::new(),
+                            what: e,
+                        });
                         out.increments.push(report);
                         break 'increments;
                     }
                 }
-                since_assembly = 0;
+                since_factor = 0;
             }
-            let k = stiffness.as_ref().expect("assembled");
             // Newton: K·Δx = F on the free components
+            let mut rhs = faer::Mat::<f64>::zeros(dofs.count, 1);
             for (i, fi) in f.iter().enumerate() {
                 for c in 0..D {
                     let col = dofs.column[D * i + c];
                     if col != usize::MAX {
-                        rhs[col] = fi[c];
+                        rhs[(col, 0)] = fi[c];
                     }
                 }
             }
-            let solved = factor
-                .as_ref()
-                .and_then(|m| pcg(k, m, &rhs, &mut dx, &mut cg));
-            if solved.is_none() {
-                match k.factor(pattern.as_ref().expect("built with the stiffness")) {
-                    Ok(m) => {
-                        dx.copy_from_slice(&rhs);
-                        m.solve(&mut dx);
-                        factor = Some(m);
-                        out.factorisations += 1;
-                    }
-                    Err(e) => {
-                        out.failure = Some(fail(iterations + report.iterations, r, e));
-                        out.increments.push(report);
-                        break 'increments;
-                    }
-                }
-            }
-            let largest = dx.iter().fold(0.0, |a: f64, b| a.max(b.abs()));
+            factor.as_ref().expect("factorised").solve(&mut rhs);
+            let largest = (0..dofs.count)
+                .map(|c| rhs[(c, 0)].abs())
+                .fold(0.0, f64::max);
             let scale = if largest > max_step {
                 max_step / largest
             } else {
@@ -482,11 +371,11 @@ pub fn solve<const D: usize, const K: usize>(
                 for c in 0..D {
                     let col = dofs.column[D * i + c];
                     if col != usize::MAX {
-                        sim.state.x[i][c] += scale * dx[col];
+                        sim.state.x[i][c] += scale * rhs[(col, 0)];
                     }
                 }
             }
-            since_assembly += 1;
+            since_factor += 1;
         };
         iterations += report.iterations;
         out.iterations = iterations;
@@ -534,74 +423,4 @@ pub fn solve<const D: usize, const K: usize>(
         model.set_frozen(false, &sim.mech, &sim.state.x);
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A chain of n springs fixed at one end (tridiagonal, SPD), spring k of stiffness s(k).
-    fn chain(n: usize, s: impl Fn(usize) -> f64) -> Stiffness {
-        let mut t = Vec::new();
-        for i in 0..n {
-            // spring i joins node i − 1 (the support for i = 0) and node i
-            t.push(faer::sparse::Triplet::new(i, i, s(i)));
-            if i + 1 < n {
-                t.push(faer::sparse::Triplet::new(i, i, s(i + 1)));
-                t.push(faer::sparse::Triplet::new(i, i + 1, -s(i + 1)));
-                t.push(faer::sparse::Triplet::new(i + 1, i, -s(i + 1)));
-            }
-        }
-        Stiffness(SparseColMat::try_new_from_triplets(n, n, &t).unwrap())
-    }
-
-    fn factor(k: &Stiffness) -> Factor {
-        let llt = SymbolicLlt::try_new(k.0.symbolic(), Side::Lower).unwrap();
-        let p = Pattern {
-            keep: vec![],
-            symbolic: k.0.symbolic().to_owned().unwrap(),
-            argsort: SymbolicSparseColMat::try_new_from_indices(1, 1, &[Pair::new(0, 0)])
-                .unwrap()
-                .1,
-            llt,
-            values: vec![],
-        };
-        k.factor(&p).unwrap()
-    }
-
-    #[test]
-    fn conjugate_gradients_need_one_iteration_per_changed_spring_and_one_more() {
-        let n = 200;
-        let b: Vec<f64> = (0..n).map(|i| ((i * 7) % 13) as f64 - 6.0).collect();
-        let before = chain(n, |_| 1.0e9);
-        // two springs damaged since the factorisation: a rank-2 change of K
-        let after = chain(n, |k| match k {
-            57 => 0.3e9,
-            140 => 0.05e9,
-            _ => 1.0e9,
-        });
-        let exact = {
-            let mut x = b.clone();
-            factor(&after).solve(&mut x);
-            x
-        };
-        let mut cg = Cg::default();
-        let mut x = vec![0.0; n];
-        // with the factor of the same stiffness, one iteration is the direct solve
-        let it = pcg(&after, &factor(&after), &b, &mut x, &mut cg);
-        assert_eq!(it, Some(1));
-        let err = |x: &[f64]| {
-            let num: f64 = x.iter().zip(&exact).map(|(a, e)| (a - e).powi(2)).sum();
-            let den: f64 = exact.iter().map(|e| e * e).sum();
-            (num / den).sqrt()
-        };
-        assert!(err(&x) < 1e-12, "{}", err(&x));
-        // with the stale factor, exact arithmetic needs rank + 1 = 3 iterations
-        let it = pcg(&after, &factor(&before), &b, &mut x, &mut cg).expect("within CG_MAX");
-        assert!(it <= 3, "{it} iterations");
-        assert!(err(&x) < 1e-9, "{}", err(&x));
-        // a change of many springs by many factors is left to a new factorisation
-        let softened = chain(n, |k| 1.0e9 * (0.01 + ((k * 37) % 101) as f64 / 100.0));
-        assert_eq!(pcg(&softened, &factor(&before), &b, &mut x, &mut cg), None);
-    }
 }
