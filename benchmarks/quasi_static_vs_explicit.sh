@@ -88,6 +88,10 @@ def softening_error(curve, ref):
         worst = max(worst, abs(g - f) / fpk)
     return worst
 
+def lost(s):
+    """W − U − K: the dissipated energy with the dampers' share, the whole irrecoverable work."""
+    return s["dissipated_energy_J"] + s.get("damping_energy_J", 0.0)
+
 print(f'{"scene":<22} {"method":<13} {"to peak s":>9} {"total s":>8} {"peak kN":>9} {"ref kN":>9} '
       f'{"peak err %":>10} {"soft err %":>10} {"W_d J":>8} {"W_d/ref":>8} {"W-U/ref":>8} {"unconv":>6}')
 for n in sys.argv[2:]:
@@ -101,8 +105,6 @@ for n in sys.argv[2:]:
         rp = r["peak_force_N"] if r else float("nan")
         soft = 100 * softening_error(c, rc) if r else float("nan")
         wr = s["dissipated_energy_J"] / r["dissipated_energy_J"] if r else float("nan")
-        # W − U − K: the dissipated energy with the dampers' share, the whole irrecoverable work
-        lost = lambda x: x["dissipated_energy_J"] + x.get("damping_energy_J", 0.0)
         lr = lost(s) / lost(r) if r else float("nan")
         un = s.get("unconverged_increments")
         print(f'{n:<22} {m:<13} {s["wall_time_to_peak_s"]:9.3f} {s["wall_time_s"]:8.2f} {pk/1e3:9.3f} '

@@ -41,8 +41,8 @@ pub struct Summary {
     pub max_final_residual: Option<f64>,
     /// Quasi-static: state commits (secant iterations) of all increments.
     pub commits: Option<usize>,
-    /// Quasi-static with damage: Cholesky factorisations of the held stiffness (the Newton
-    /// steps between them are solved by conjugate gradients preconditioned with the last).
+    /// Quasi-static with damage: Cholesky factorisations of the held stiffness (one per
+    /// state-changing commit and per NEWTON_PER_FACTOR Newton iterations of a held state).
     pub factorisations: Option<usize>,
     /// The run stopped after its peak (`loading.stop_after_peak`), before t_end.
     pub stopped_after_peak: bool,
