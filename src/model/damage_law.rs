@@ -130,7 +130,9 @@ where
     fn kernel(&self) -> Kernel;
 
     /// (d, √d) of a bond between particles in states `i` and `j` with elastic stretch
-    /// `elastic_stretch`; `FULL` is the kernel running ([`Kernel::Full`]).
+    /// `elastic_stretch`; `FULL` is the kernel running ([`Kernel::Full`]). The second must be
+    /// `d.sqrt()` bit for bit: the kernel's pass 2 recomputes it so from d
+    /// (`solver::concrete::SlotCache`).
     fn bond_factor<const FULL: bool>(
         &self,
         i: &Self::State,

@@ -13,12 +13,13 @@
 //!    Where the law's bond factor is the two springs in series ([`DamageLaw::SERIES_DAMAGE`])
 //!    and the CPU has AVX, the slot loop runs four particles at a time (`avx::slot_block`,
 //!    bit-identical to `slot_pass`; `tests::pass_state_simd_matches_scalar_bitwise`).
-//!    Pass 1 leaves each slot's 1/length, d·(a_i + a_j)·S_e, √d and d in the slot cache
-//!    ([`SlotCache`], blocks of four particles).
+//!    Pass 1 leaves each slot's d·(a_i + a_j)·S_e and d in the slot cache ([`SlotCache`],
+//!    blocks of four particles).
 //! 2. Each particle gathers F_b,ij = ½(d_ij·(a_i + a_j)·S_e,ij + √d_ij·(bθ_i + bθ_j)) along
-//!    e_ij, with the bond damper scaled by d_ij, and integrates. With AVX in 2D, four particles
-//!    at a time (`avx::force_block`, for any law: it reads only the slot cache), bit-identical
-//!    to `particle_force` (the same test, three whole steps).
+//!    e_ij, with the bond damper scaled by d_ij, and integrates; e_ij and √d_ij are
+//!    recomputed as pass 1 computed them. With AVX in 2D, four particles at a time
+//!    (`avx::force_block`, for any law: it reads only the slot cache and the positions),
+//!    bit-identical to `particle_force` (the same test, three whole steps).
 //!
 //! **Decision (erratum to (3.36)).** As written, F_s,ij = d_ij·a·S_e,ij + b·Σ_m d_im·S_e,im
 //! leaves the dilatation term on a bond whose particle is fully damaged: a broken particle i
@@ -64,8 +65,8 @@ mod avx;
 /// Bytes per particle the damage kernel ([`Concrete`]) allocates beside the elastic run's
 /// (`discretise::bytes_per_particle`), counted field by field: the strain projector
 /// (D(D+1)/2 × K f64), the committed and trial plastic stretch states (2·K f64), the slot
-/// cache (4·K f64), the reverse slots (K u8), the committed and trial law states (2 × 32 B)
-/// and the length scale (f64). D = 2, K = 6: 510 B; D = 3, K = 18 (FCC): 1818 B.
+/// cache (2·K f64), the reverse slots (K u8), the committed and trial law states (2 × 32 B)
+/// and the length scale (f64). D = 2, K = 6: 414 B; D = 3, K = 18 (FCC): 1530 B.
 pub const fn bytes_per_particle(d: usize, k: usize) -> usize {
     (d * (d + 1) / 2 + 2 + FIELDS) * k * 8 + k + 2 * std::mem::size_of::<ParticleDamage>() + 8
 }
@@ -329,32 +330,34 @@ where
     }
 }
 
-/// What pass 2 needs of one slot, left by pass 1 at the same positions and state: the inverse
-/// current length 1/|x_j − x_i|, d·(a_i + a_j)·S_e, √d and d (0 everywhere in an empty slot).
+/// What pass 2 needs of one slot, left by pass 1 at the same positions and state:
+/// d·(a_i + a_j)·S_e and d (0 in an empty slot).
 ///
-/// **Decision (measured).** Pass 2 recomputes the unit vector e = (x_j − x_i)·(1/|x_j − x_i|),
-/// the same operations on the same inputs as pass 1's, so the same bits, rather than reading
-/// it: 32 bytes a slot instead of 40. The cache is laid out in blocks of [`LANES`] particles,
-/// each field of a slot four lanes wide ([`slot_cache_at`]), so that the AVX passes load and
-/// store it a vector at a time (benchmarks/RESULTS.md, "Sixth attempt").
+/// **Decision (measured).** Pass 2 recomputes the rest from the same inputs with the same
+/// operations as pass 1, so the same bits, rather than reading it: the length
+/// |x_j − x_i| and its inverse, the unit vector e = (x_j − x_i)·(1/|x_j − x_i|), and
+/// √d = `d.sqrt()` ([`DamageLaw::bond_factor`] returns that square root). 16 bytes a slot
+/// instead of 32 (40 with e): the kernel is memory-bound, and a square root and a division
+/// per slot cost less than the 16 bytes written and read again (benchmarks/RESULTS.md,
+/// "Concrete kernels: a two-field slot cache"). The cache is laid out in blocks of
+/// [`LANES`] particles, each field of a slot four lanes wide ([`slot_cache_at`]), so that the
+/// AVX passes load and store it a vector at a time (benchmarks/RESULTS.md, "Sixth attempt").
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SlotCache {
-    inv_len: f64,
     d_a_se: f64,
-    sd: f64,
     d: f64,
 }
 
 /// The slot cache's fields per slot.
-const FIELDS: usize = 4;
+const FIELDS: usize = 2;
 
 /// Length of the slot cache of n particles with k slots each ([`lane_cache_len`]).
 pub(crate) const fn slot_cache_len(n: usize, k: usize) -> usize {
     lane_cache_len(n, k, FIELDS)
 }
 
-/// Index in the slot cache of the first field (1/length) of slot k of particle i; the fields
-/// d·(a_i + a_j)·S_e, √d and d follow [`LANES`] entries apart each.
+/// Index in the slot cache of the first field (d·(a_i + a_j)·S_e) of slot k of particle i; the
+/// second, d, follows [`LANES`] entries on.
 #[inline(always)]
 pub(crate) const fn slot_cache_at(i: usize, k: usize, slots: usize) -> usize {
     lane_cache_at(i, k, slots, FIELDS)
@@ -364,19 +367,15 @@ impl SlotCache {
     #[inline(always)]
     fn read(cache: &[f64], at: usize) -> Self {
         SlotCache {
-            inv_len: cache[at],
-            d_a_se: cache[at + LANES],
-            sd: cache[at + 2 * LANES],
-            d: cache[at + 3 * LANES],
+            d_a_se: cache[at],
+            d: cache[at + LANES],
         }
     }
 
     #[inline(always)]
     fn write(self, cache: &mut [f64], at: usize) {
-        cache[at] = self.inv_len;
-        cache[at + LANES] = self.d_a_se;
-        cache[at + 2 * LANES] = self.sd;
-        cache[at + 3 * LANES] = self.d;
+        cache[at] = self.d_a_se;
+        cache[at + LANES] = self.d;
     }
 }
 
@@ -384,8 +383,6 @@ impl SlotCache {
 #[derive(Clone, Copy)]
 struct Slot<const D: usize> {
     e: SVector<f64, D>,
-    /// 1/|x_j − x_i|.
-    inv_len: f64,
     st: f64,
     se: f64,
     d: f64,
@@ -435,10 +432,8 @@ where
     let (d, sd) = c
         .law
         .bond_factor::<FULL>(&c.committed[i], &c.committed[j], branch);
-    let inv_len = 1.0 / len;
     Some(Slot {
-        e: dx * inv_len,
-        inv_len,
+        e: dx * (1.0 / len),
         st,
         se,
         d,
@@ -530,9 +525,7 @@ where
                 s.theta_e += weighted(w, k, b.se);
                 s.same &= s.dse[k] == s.st[k];
                 SlotCache {
-                    inv_len: b.inv_len,
                     d_a_se: damaged_axial(b.d, mi, mj, b.se),
-                    sd: b.sd,
                     d: b.d,
                 }
             }
@@ -759,8 +752,8 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
 }
 
 /// Internal force on particle i and the power of its bond dampers (half of each bond's),
-/// from the slot cache pass 1 left at positions x and every particle's bθ; the unit vector is
-/// recomputed as pass 1 computed it (see [`SlotCache`]). `avx::force_block` does four
+/// from the slot cache pass 1 left at positions x and every particle's bθ; the unit vector
+/// and √d are recomputed as pass 1 computed them (see [`SlotCache`]). `avx::force_block` does four
 /// particles at once, bit for bit the same.
 #[inline]
 fn particle_force<const D: usize, const K: usize, L: DamageLaw<D, K>, const DAMP: bool>(
@@ -783,8 +776,10 @@ where
             continue;
         }
         let j = j as usize;
-        let e = (x[j] - xi) * s.inv_len;
-        let mut fb = damaged_bond_force(s.d_a_se, s.sd, b_theta[i], b_theta[j]);
+        // as pass 1 (`slot`): the same operations, the same bits
+        let dx = x[j] - xi;
+        let e = dx * (1.0 / dx.norm());
+        let mut fb = damaged_bond_force(s.d_a_se, s.d.sqrt(), b_theta[i], b_theta[j]);
         if DAMP {
             let cb = s.d * 0.5 * (m.c_in[i] + m.c_in[j]);
             let rate = (v[j] - v[i]).dot(&e);
@@ -1488,7 +1483,7 @@ mod tests {
         assert_eq!(bytes_per_particle(3, 18), count::<3, 18>());
         assert_eq!(
             (bytes_per_particle(2, 6), bytes_per_particle(3, 18)),
-            (510, 1818)
+            (414, 1530)
         );
     }
 

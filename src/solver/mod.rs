@@ -159,16 +159,39 @@ impl PeakStop {
     }
 }
 
-/// A run that went unstable.
-#[derive(Debug, thiserror::Error)]
-#[error("the run went unstable at step {step} (t = {time:.6e} s): {what} at particle {particle} (reference position {position}); reduce solver.safety or solver.dt, or check the material and the loading")]
+/// A run that went unstable, or whose quasi-static solve broke down.
+#[derive(Debug, Clone)]
 pub struct Unstable {
+    /// The step; for the quasi-static solver, the Newton iteration counted over the run.
     pub step: usize,
+    /// The time (s); for the quasi-static solver, the load factor.
     pub time: f64,
     pub particle: usize,
     pub position: String,
     pub what: String,
+    /// `Some(n)`: the quasi-static solver's increment n (1-based) could not be solved; no
+    /// particle is named (the failure is the whole stiffness's).
+    pub increment: Option<usize>,
 }
+
+impl std::fmt::Display for Unstable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.increment {
+            None => write!(
+                f,
+                "the run went unstable at step {} (t = {:.6e} s): {} at particle {} (reference position {}); reduce solver.safety or solver.dt, or check the material and the loading",
+                self.step, self.time, self.what, self.particle, self.position
+            ),
+            Some(n) => write!(
+                f,
+                "the quasi-static solver stopped at increment {n} (load factor {:.6}, iteration {} of the run): {}; raise solver.increments (less damage grows in each), or run solver.method = \"explicit\"",
+                self.time, self.step, self.what
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Unstable {}
 
 /// How much energy beyond what was put in (in units of the energy put in) the stability guard
 /// tolerates before it stops a run ([`Simulation::check_stability`]): 10, the margin of the
@@ -558,6 +581,44 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             particle,
             position: format!("{:?}", self.x0[particle].as_slice()),
             what,
+            increment: None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Unstable;
+
+    /// A quasi-static breakdown names the increment and load factor and the keys that apply
+    /// to that solver, not the explicit step's (solver.safety, solver.dt) nor a particle.
+    #[test]
+    fn quasi_static_breakdown_names_the_increment_and_its_remedy() {
+        let e = Unstable {
+            step: 812,
+            time: 0.4375,
+            particle: 0,
+            position: String::new(),
+            what: "the secant stiffness is not positive definite".into(),
+            increment: Some(57),
+        };
+        let msg = e.to_string();
+        assert!(
+            msg.contains("increment 57") && msg.contains("load factor 0.437500"),
+            "{msg}"
+        );
+        assert!(msg.contains("solver.increments") && msg.contains("not positive definite"));
+        assert!(
+            !msg.contains("solver.dt") && !msg.contains("particle"),
+            "{msg}"
+        );
+        let explicit = Unstable {
+            increment: None,
+            ..e
+        };
+        let msg = explicit.to_string();
+        assert!(
+            msg.contains("step 812") && msg.contains("particle 0") && msg.contains("solver.dt")
+        );
     }
 }

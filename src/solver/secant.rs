@@ -341,6 +341,7 @@ pub fn solve<const D: usize, const K: usize>(
                             particle: 0,
                             position: String::new(),
                             what: e,
+                            increment: Some(out.increments.len() + 1),
                         });
                         out.increments.push(report);
                         break 'increments;

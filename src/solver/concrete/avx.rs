@@ -96,7 +96,7 @@ unsafe fn series(wi: __m256d, wj: __m256d) -> (__m256d, __m256d) {
 ///
 /// # Safety
 /// AVX available; `L::SERIES_DAMAGE`; i0 + 4 ≤ m.len() = x.len() = c.committed.len(); every
-/// occupied slot indexes a particle; cache.len() = 4·4·K.
+/// occupied slot indexes a particle; cache.len() = 2·4·K.
 #[target_feature(enable = "avx")]
 #[inline]
 pub(super) unsafe fn slot_block<
@@ -185,8 +185,6 @@ pub(super) unsafe fn slot_block<
             )
         };
         let (d, sd) = (_mm256_and_pd(d, occ), _mm256_and_pd(sd, occ));
-        // 1/len, from which pass 2 recomputes e = dx·(1/len)
-        let rinv = _mm256_and_pd(_mm256_div_pd(one, len), occ);
         // damaged_axial: d·((m_i + m_j)·S_e) with the bond moduli (a_i, a_j), or
         // (a_i + c_i, a_j + c_j) in a second-neighbour slot (`Mechanics::bond_moduli`)
         let aj = gather(&m.a, &j);
@@ -216,10 +214,8 @@ pub(super) unsafe fn slot_block<
         same = _mm256_and_pd(same, _mm256_cmp_pd::<_CMP_EQ_OQ>(dse, st));
         let (st, se, dse, occ) = (lanes(st), lanes(se), lanes(dse), lanes(occ));
         let p = blk.add(FIELDS * LANES * k);
-        _mm256_storeu_pd(p, rinv);
-        _mm256_storeu_pd(p.add(LANES), d_a_se);
-        _mm256_storeu_pd(p.add(2 * LANES), sd);
-        _mm256_storeu_pd(p.add(3 * LANES), d);
+        _mm256_storeu_pd(p, d_a_se);
+        _mm256_storeu_pd(p.add(LANES), d);
         for l in 0..LANES {
             let o = out.get_unchecked_mut(l);
             *o.st.get_unchecked_mut(k) = st[l];
@@ -253,8 +249,8 @@ pub(super) unsafe fn slot_block<
 }
 
 /// `super::particle_force` of particles i0..i0+4, one per lane: the internal force per
-/// component and the bond dampers' power, from the slot cache. Slots with d = 0 (empty or
-/// broken) leave the sums untouched, as the scalar path skips them.
+/// component and the bond dampers' power, from the slot cache and the positions. Slots with
+/// d = 0 (empty or broken) leave the sums untouched, as the scalar path skips them.
 ///
 /// # Safety
 /// AVX available; i0 + 4 ≤ m.len(); x, v and b_theta have m.len() entries; every occupied
@@ -271,6 +267,7 @@ where
     Dim<D>: Dimension<D>,
 {
     let zero = _mm256_setzero_pd();
+    let one = _mm256_set1_pd(1.0);
     let half = _mm256_set1_pd(0.5);
     let xi = load_own(r.x, i0);
     let vi = if DAMP { load_own(r.v, i0) } else { [zero; D] };
@@ -285,22 +282,24 @@ where
     let mut power = zero;
     for k in 0..block_slots(m, i0) {
         let p = blk.add(FIELDS * LANES * k);
-        let d = _mm256_loadu_pd(p.add(3 * LANES));
-        let live = _mm256_cmp_pd::<_CMP_NEQ_UQ>(d, zero);
-        if _mm256_movemask_pd(live) == 0 {
+        let d = _mm256_loadu_pd(p.add(LANES));
+        if _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_NEQ_UQ>(d, zero)) == 0 {
             continue;
         }
-        let rinv = _mm256_loadu_pd(p);
-        let d_a_se = _mm256_loadu_pd(p.add(LANES));
-        let sd = _mm256_loadu_pd(p.add(2 * LANES));
-        // the neighbours (the particle itself in an empty slot, where d = 0); the slot's
-        // 1/L0, which pass 2 does not need, is left unused
+        let d_a_se = _mm256_loadu_pd(p);
+        // √d, as the law computes it (`super::SlotCache`)
+        let sd = _mm256_sqrt_pd(d);
+        // the neighbours (the particle itself in an empty slot, where d = 0: its zero
+        // length gives e = NaN, which the blends below drop); the slot's 1/L0, which pass 2
+        // does not need, is left unused
         let (j, _, _) = slot(m, i0, k);
-        let xj = gather_vec(r.x, &j);
-        // e = (x_j − x_i)·(1/len)
+        let (dx, len) = geometry(&xi, &gather_vec(r.x, &j));
+        let live = _mm256_cmp_pd::<_CMP_NEQ_UQ>(d, zero);
+        // e = (x_j − x_i)·(1/len), as pass 1 computes len and as the scalar path
+        let rinv = _mm256_div_pd(one, len);
         let mut e = [zero; D];
         for cc in 0..D {
-            e[cc] = _mm256_mul_pd(_mm256_sub_pd(xj[cc], xi[cc]), rinv);
+            e[cc] = _mm256_mul_pd(dx[cc], rinv);
         }
         // damaged_bond_force: ½(d·(a_i + a_j)·S_e + √d·(bθ_i + bθ_j))
         let btj = gather(r.b_theta, &j);
