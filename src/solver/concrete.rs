@@ -337,9 +337,9 @@ where
 /// operations as pass 1, so the same bits, rather than reading it: the length
 /// |x_j − x_i| and its inverse, the unit vector e = (x_j − x_i)·(1/|x_j − x_i|), and
 /// √d = `d.sqrt()` ([`DamageLaw::bond_factor`] returns that square root). 16 bytes a slot
-/// instead of 32 (40 with e): the kernel is memory-bound, and a square root and a division
-/// per slot cost less than the 16 bytes written and read again (benchmarks/RESULTS.md,
-/// "Concrete kernels: a two-field slot cache"). The cache is laid out in blocks of
+/// instead of 32 (40 with e): the kernel is memory-bound, and two square roots and a
+/// division per slot cost less than the 16 bytes written and read again (AVX tension kernel
+/// +9 to +22%: benchmarks/RESULTS.md, "Concrete kernels: a two-field slot cache"). The cache is laid out in blocks of
 /// [`LANES`] particles, each field of a slot four lanes wide ([`slot_cache_at`]), so that the
 /// AVX passes load and store it a vector at a time (benchmarks/RESULTS.md, "Sixth attempt").
 #[derive(Clone, Copy, Debug, Default)]
