@@ -12,7 +12,8 @@
 //! there. Wall times include the set-up (lattice, fundamental period, stable step). Then the
 //! error of each run (deviation of its peak load from the converged reference,
 //! `sppm::study::pareto::reference`) goes to `pareto.csv`, the error against wall time to
-//! `pareto.svg`, and one line says how near the shipped default lies to the front. f32 is not offered by the kernels, so it is not swept.
+//! `pareto.svg`, and one line says how near the shipped default lies to the front. f32 is
+//! not offered by the kernels, so it is not swept.
 
 use anyhow::{bail, Context};
 use plotters::prelude::*;

@@ -339,9 +339,10 @@ where
 /// √d = `d.sqrt()` ([`DamageLaw::bond_factor`] returns that square root). 16 bytes a slot
 /// instead of 32 (40 with e): the kernel is memory-bound, and two square roots and a
 /// division per slot cost less than the 16 bytes written and read again (AVX tension kernel
-/// +9 to +22%: benchmarks/RESULTS.md, "Concrete kernels: a two-field slot cache"). The cache is laid out in blocks of
-/// [`LANES`] particles, each field of a slot four lanes wide ([`slot_cache_at`]), so that the
-/// AVX passes load and store it a vector at a time (benchmarks/RESULTS.md, "Sixth attempt").
+/// +9 to +22%: benchmarks/RESULTS.md, "Concrete kernels: a two-field slot cache"). The cache
+/// is laid out in blocks of [`LANES`] particles, each field of a slot four lanes wide
+/// ([`slot_cache_at`]), so that the AVX passes load and store it a vector at a time
+/// (benchmarks/RESULTS.md, "Sixth attempt").
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SlotCache {
     d_a_se: f64,
@@ -753,8 +754,8 @@ fn pass_state<const D: usize, const K: usize, L: DamageLaw<D, K>, const FULL: bo
 
 /// Internal force on particle i and the power of its bond dampers (half of each bond's),
 /// from the slot cache pass 1 left at positions x and every particle's bθ; the unit vector
-/// and √d are recomputed as pass 1 computed them (see [`SlotCache`]). `avx::force_block` does four
-/// particles at once, bit for bit the same.
+/// and √d are recomputed as pass 1 computed them (see [`SlotCache`]). `avx::force_block`
+/// does four particles at once, bit for bit the same.
 #[inline]
 fn particle_force<const D: usize, const K: usize, L: DamageLaw<D, K>, const DAMP: bool>(
     m: &Mechanics<D, K>,

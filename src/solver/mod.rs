@@ -160,7 +160,7 @@ impl PeakStop {
 }
 
 /// A run that went unstable, or whose quasi-static solve broke down.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Unstable {
     /// The step; for the quasi-static solver, the Newton iteration counted over the run.
     pub step: usize,

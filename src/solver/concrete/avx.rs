@@ -283,7 +283,8 @@ where
     for k in 0..block_slots(m, i0) {
         let p = blk.add(FIELDS * LANES * k);
         let d = _mm256_loadu_pd(p.add(LANES));
-        if _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_NEQ_UQ>(d, zero)) == 0 {
+        let live = _mm256_cmp_pd::<_CMP_NEQ_UQ>(d, zero);
+        if _mm256_movemask_pd(live) == 0 {
             continue;
         }
         let d_a_se = _mm256_loadu_pd(p);
@@ -294,7 +295,6 @@ where
         // does not need, is left unused
         let (j, _, _) = slot(m, i0, k);
         let (dx, len) = geometry(&xi, &gather_vec(r.x, &j));
-        let live = _mm256_cmp_pd::<_CMP_NEQ_UQ>(d, zero);
         // e = (x_j − x_i)·(1/len), as pass 1 computes len and as the scalar path
         let rinv = _mm256_div_pd(one, len);
         let mut e = [zero; D];
