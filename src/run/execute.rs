@@ -231,6 +231,7 @@ fn run_prepared<const K: usize, const D: usize>(
                 stopped_after_peak: r.stopped_after_peak,
                 commits: quasi_static.then(|| r.increments.iter().map(|i| i.commits).sum()),
                 factorisations: implicit.then_some(r.factorisations),
+                cutbacks: implicit.then_some(r.cutbacks),
                 stopped_unconverged: r.stopped_unconverged,
             };
             increments = r.increments;

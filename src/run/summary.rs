@@ -44,6 +44,9 @@ pub struct Summary {
     /// Quasi-static with damage: Cholesky factorisations of the held stiffness (one per
     /// state-changing commit and per NEWTON_PER_FACTOR Newton iterations of a held state).
     pub factorisations: Option<usize>,
+    /// Quasi-static with damage: increments undone and taken again in half the step because
+    /// damage jumped in them (their iterations are counted in `iterations`).
+    pub cutbacks: Option<usize>,
     /// The run stopped after its peak (`loading.stop_after_peak`), before t_end.
     pub stopped_after_peak: bool,
     pub threads: usize,
@@ -192,6 +195,8 @@ pub(super) struct SolverReport {
     pub commits: Option<usize>,
     /// Quasi-static with damage: Cholesky factorisations.
     pub factorisations: Option<usize>,
+    /// Quasi-static with damage: increments undone and taken again in half the step.
+    pub cutbacks: Option<usize>,
     /// Quasi-static: the increment the run stopped at because it did not converge.
     pub stopped_unconverged: Option<crate::solver::relaxation::IncrementReport>,
 }
@@ -317,6 +322,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         max_final_residual: report.max_final_residual,
         commits: report.commits,
         factorisations: report.factorisations,
+        cutbacks: report.cutbacks,
         stopped_after_peak: report.stopped_after_peak,
         threads,
         probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),

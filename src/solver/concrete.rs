@@ -45,7 +45,7 @@ use super::kernel::{
 };
 use super::mechanics::{weighted, Mechanics};
 use super::KernelSet;
-use crate::aligned::{filled, Aligned};
+use crate::aligned::{copied, filled, Aligned};
 use crate::discretise::{Particles, NONE};
 pub use crate::model::damage_law::ParticleDamage;
 use crate::model::damage_law::{DamageLaw, Kernel, ParticleBonds};
@@ -125,6 +125,13 @@ where
     /// a second flip is refused (the bond keeps its branch), so that a bond whose equilibrium
     /// stretch changes sign with its branch cannot keep the iterations from settling.
     flipped: Vec<u32>,
+    /// The law state at the start of the quasi-static solver's load increment
+    /// ([`Self::begin_increment`]; empty outside that solver).
+    start: Aligned<L::State>,
+    /// The plastic stretch states at the start of the increment.
+    sps_start: Aligned<[f64; K]>,
+    /// [`Self::shortened`] at the start of the increment.
+    shortened_start: Vec<u32>,
 }
 
 /// The criteria (initiation, yield) of a particle read the volume-weighted mean of the damaged
@@ -151,6 +158,8 @@ pub struct Neighbourhood<const D: usize> {
     /// Committed damaged elastic strain of every particle (previous step).
     strain: Vec<Tensor<D>>,
     strain_trial: Vec<Tensor<D>>,
+    /// `strain` at the start of a quasi-static increment ([`Concrete::undo_increment`]).
+    strain_start: Vec<Tensor<D>>,
 }
 
 impl<const D: usize> Neighbourhood<D> {
@@ -213,6 +222,9 @@ where
             frozen: false,
             shortened: Vec::new(),
             flipped: Vec::new(),
+            start: Aligned::new(0),
+            sps_start: Aligned::new(0),
+            shortened_start: Vec::new(),
         }
     }
 
@@ -223,6 +235,7 @@ where
             volume: p.volume.clone(),
             strain: vec![Tensor::<D>::zeros(); n],
             strain_trial: vec![Tensor::<D>::zeros(); n],
+            strain_start: Vec::new(),
         });
         self
     }
@@ -264,17 +277,7 @@ where
     /// Returns how much the state moved: the largest change of w_t or w_c of a particle,
     /// and the number of bond ends whose branch changed.
     pub fn commit_at(&mut self, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) -> (f64, usize) {
-        let law = &self.law;
-        let change = self
-            .committed
-            .par_iter()
-            .zip(self.trial.par_iter())
-            .with_min_len(1024)
-            .map(|(a, b)| {
-                let (a, b) = (law.view(a), law.view(b));
-                (a.wt - b.wt).abs().max((a.wc - b.wc).abs())
-            })
-            .reduce(|| 0.0, f64::max);
+        let change = self.largest_change(&self.trial);
         self.commit();
         let mut flips = 0;
         if self.frozen {
@@ -294,6 +297,55 @@ where
     /// Let every bond flip its branch again (at the start of a load increment).
     pub fn unlock_branches(&mut self) {
         self.flipped.iter_mut().for_each(|f| *f = 0);
+    }
+
+    /// A load increment starts from the committed state: keep it, its branches and its
+    /// criteria strains ([`Self::undo_increment`], [`Self::growth`]), and let every bond
+    /// flip its branch again.
+    pub fn begin_increment(&mut self) {
+        self.unlock_branches();
+        if self.start.len() == self.committed.len() {
+            self.start.copy_from_slice(&self.committed);
+            self.sps_start.copy_from_slice(&self.sps);
+        } else {
+            self.start = copied(&self.committed);
+            self.sps_start = copied(&self.sps);
+        }
+        self.shortened_start.clone_from(&self.shortened);
+        if let Some(nb) = &mut self.neighbourhood {
+            nb.strain_start.clone_from(&nb.strain);
+        }
+    }
+
+    /// Undo the increment: the state, branches and criteria strains of its start again
+    /// (the quasi-static solver's cut-back of an increment in which damage jumped).
+    pub fn undo_increment(&mut self) {
+        self.committed.copy_from_slice(&self.start);
+        self.sps.copy_from_slice(&self.sps_start);
+        self.shortened.clone_from(&self.shortened_start);
+        if let Some(nb) = &mut self.neighbourhood {
+            nb.strain.clone_from(&nb.strain_start);
+        }
+    }
+
+    /// The largest change of a particle's w_t or w_c since [`Self::begin_increment`].
+    pub fn growth(&self) -> f64 {
+        self.largest_change(&self.start)
+    }
+
+    /// The largest difference of a particle's w_t or w_c between the committed state and
+    /// `other`.
+    fn largest_change(&self, other: &[L::State]) -> f64 {
+        let law = &self.law;
+        self.committed
+            .par_iter()
+            .zip(other.par_iter())
+            .with_min_len(1024)
+            .map(|(a, b)| {
+                let (a, b) = (law.view(a), law.view(b));
+                (a.wt - b.wt).abs().max((a.wc - b.wc).abs())
+            })
+            .reduce(|| 0.0, f64::max)
     }
 
     /// The shortened slots of every particle at `x` with the committed plastic stretch. A
@@ -918,9 +970,14 @@ where
             let mut out = [None; K];
             for (k, o) in out.iter_mut().enumerate() {
                 if let Some(s) = slot::<D, K, L, FULL>(m, c, x, i, k) {
+                    // a broken bond (d = √d = 0) adds zeros, also where its ends have met
+                    // and its direction is not defined (measured: NaN entries on the split
+                    // cylinder after cracking, where two pieces' particles coincided); the
+                    // entries stay, as the pattern is built once
+                    let broken = s.d == 0.0 && s.sd == 0.0;
                     *o = Some(HeldSlot {
                         j: m.neighbours[i][k] as usize,
-                        e: s.e,
+                        e: if broken { SVector::zeros() } else { s.e },
                         d: s.d,
                         sd: s.sd,
                         theta: weighted(w, k, s.sd * m.inv_l0[i][k]),
@@ -1091,8 +1148,12 @@ pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
     /// Make the trial state of the last step (computed at the positions that step started
     /// from) the committed one; a held state also takes each bond's branch at `x`.
     fn commit(&mut self, m: &Mechanics<D, K>, x: &[nalgebra::SVector<f64, D>]) -> (f64, usize);
-    /// Let every held bond change its branch again at a commit (a new load increment).
-    fn unlock_branches(&mut self);
+    /// A new load increment ([`Concrete::begin_increment`]).
+    fn begin_increment(&mut self);
+    /// The largest change of w_t or w_c in this increment ([`Concrete::growth`]).
+    fn growth(&self) -> f64;
+    /// Back to the increment's start ([`Concrete::undo_increment`]).
+    fn undo_increment(&mut self);
     /// Internal forces (no dampers) at positions x with the committed state; the trial state
     /// becomes the one computed at x ([`internal_forces`]).
     fn forces(
@@ -1166,8 +1227,14 @@ where
     fn commit(&mut self, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) -> (f64, usize) {
         self.commit_at(m, x)
     }
-    fn unlock_branches(&mut self) {
-        Concrete::unlock_branches(self)
+    fn begin_increment(&mut self) {
+        Concrete::begin_increment(self)
+    }
+    fn growth(&self) -> f64 {
+        Concrete::growth(self)
+    }
+    fn undo_increment(&mut self) {
+        Concrete::undo_increment(self)
     }
     fn forces(&mut self, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) -> Vec<SVector<f64, D>> {
         internal_forces(m, self, x)
@@ -1565,6 +1632,75 @@ mod tests {
         check_stiffness::<3, 18>(&fcc, true);
     }
 
+    /// A broken bond whose two particles have met (a separated piece pushed onto its
+    /// neighbour) has no direction: its stiffness entries are zeros, not NaN, and the
+    /// triplets are the same ones as before (the quasi-static solver's pattern is built once).
+    #[test]
+    fn broken_bond_with_coincident_ends_adds_zeros_to_the_stiffness() {
+        let (hex, _) = bodies();
+        let (m, mut c, mut x) = damaged::<2, 6>(&hex, false, 11);
+        c.freeze(true, &m, &x);
+        // a bond held on the tensile branch (the tension kernel has no compressive damage)
+        let i = hex.len() / 2;
+        let (k, j) = (0..6)
+            .map(|k| (k, hex.neighbours[i][k]))
+            .find(|&(k, j)| j != NONE && (c.shortened[i] >> k) & 1 == 0)
+            .expect("an interior particle has a lengthened bond");
+        let j = j as usize;
+        c.committed[i].wt = 1.0;
+        c.committed[j].wt = 1.0;
+        let before = secant_stiffness(&m, &c, &x);
+        x[j] = x[i];
+        let s = slot::<2, 6, TwoSpring<2>, false>(&m, &c, &x, i, k).unwrap();
+        assert!(
+            s.d == 0.0 && s.sd == 0.0 && !s.e.x.is_finite(),
+            "{} {} {}",
+            s.d,
+            s.sd,
+            s.e
+        );
+        let after = secant_stiffness(&m, &c, &x);
+        assert!(after.iter().all(|t| t.2.is_finite()));
+        assert!(before
+            .iter()
+            .zip(&after)
+            .all(|(a, b)| (a.0, a.1) == (b.0, b.1)));
+        assert_eq!(before.len(), after.len());
+    }
+
+    /// An undone increment leaves the committed state, plastic stretch, branches and
+    /// criteria strains as they were at its start, and its growth is the largest change of
+    /// w_t or w_c since then.
+    #[test]
+    fn undo_increment_restores_the_start_and_growth_measures_from_it() {
+        let (_, rnd) = bodies();
+        let (m, c, x) = damaged::<2, 12>(&rnd, true, 7);
+        let mut c = c.with_neighbourhood_criteria(&rnd);
+        c.freeze(true, &m, &x);
+        c.begin_increment();
+        let (state, sps) = (c.committed.to_vec(), c.sps.to_vec());
+        let shortened = c.shortened.clone();
+        let strain = c.neighbourhood.as_ref().unwrap().strain.clone();
+        assert_eq!(c.growth(), 0.0);
+        // a strained step: the trial state differs from the start
+        let far: Vec<_> = x
+            .iter()
+            .zip(&rnd.x0)
+            .map(|(x, x0)| x0 + (x - x0) * 3.0)
+            .collect();
+        internal_forces(&m, &mut c, &far);
+        let (dw, _) = c.commit_at(&m, &far);
+        assert!(dw > 0.0);
+        let g = c.growth();
+        assert!(g >= dw && g > 0.0, "{g} {dw}");
+        c.undo_increment();
+        assert!(c.committed.iter().zip(&state).all(|(a, b)| a == b));
+        assert!(c.sps.iter().zip(&sps).all(|(a, b)| a == b));
+        assert_eq!(c.shortened, shortened);
+        assert_eq!(c.neighbourhood.as_ref().unwrap().strain, strain);
+        assert_eq!(c.growth(), 0.0);
+    }
+
     #[test]
     fn pass_state_simd_matches_scalar_bitwise() {
         if !use_avx() {
@@ -1605,6 +1741,7 @@ mod tests {
                 Matrix2::new(-8.0, 1.0, 1.0, 6.0),
             ],
             strain_trial: vec![Matrix2::zeros(); 3],
+            strain_start: Vec::new(),
         };
         let row = [1, NONE, 2];
         let all = nb.mean(0, &row, |_| false);

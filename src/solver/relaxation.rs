@@ -106,6 +106,8 @@ pub struct Relaxed {
     pub stopped_unconverged: Option<IncrementReport>,
     /// Cholesky factorisations of the held stiffness (`solver::secant`; 0 here).
     pub factorisations: usize,
+    /// Increments undone and taken again in half the step (`solver::secant`; 0 here).
+    pub cutbacks: usize,
 }
 
 /// Switch the dampers off and compute the stable limit of the undamped model.
