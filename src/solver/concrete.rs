@@ -971,9 +971,10 @@ where
             for (k, o) in out.iter_mut().enumerate() {
                 if let Some(s) = slot::<D, K, L, FULL>(m, c, x, i, k) {
                     // a broken bond (d = √d = 0) adds zeros, also where its ends have met
-                    // and its direction is not defined (measured: NaN entries on the split
-                    // cylinder after cracking, where two pieces' particles coincided); the
-                    // entries stay, as the pattern is built once
+                    // and its direction is not defined (met on the split cylinder after
+                    // cracking, with a variant of the solver measured at stop 34: NaN
+                    // entries, then a failed factorisation); the entries stay, as the
+                    // pattern is built once
                     let broken = s.d == 0.0 && s.sd == 0.0;
                     *o = Some(HeldSlot {
                         j: m.neighbours[i][k] as usize,
