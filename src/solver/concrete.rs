@@ -126,7 +126,7 @@ where
     /// stretch changes sign with its branch cannot keep the iterations from settling.
     flipped: Vec<u32>,
     /// The law state at the start of the quasi-static solver's load increment
-    /// ([`Self::begin_increment`]; empty outside that solver).
+    /// ([`Self::begin_increment`]; allocated by [`Self::freeze`], empty before).
     start: Aligned<L::State>,
     /// The plastic stretch states at the start of the increment.
     sps_start: Aligned<[f64; K]>,
@@ -268,6 +268,8 @@ where
         if frozen {
             self.shortened = self.branches(m, x, None);
             self.flipped = vec![0; m.len()];
+            self.start = copied(&self.committed);
+            self.sps_start = copied(&self.sps);
         }
         self.frozen = frozen;
     }
@@ -294,23 +296,13 @@ where
         (change, flips)
     }
 
-    /// Let every bond flip its branch again (at the start of a load increment).
-    pub fn unlock_branches(&mut self) {
-        self.flipped.iter_mut().for_each(|f| *f = 0);
-    }
-
-    /// A load increment starts from the committed state: keep it, its branches and its
-    /// criteria strains ([`Self::undo_increment`], [`Self::growth`]), and let every bond
-    /// flip its branch again.
+    /// A load increment of a held state ([`Self::freeze`]) starts from the committed state:
+    /// keep it, its branches and its criteria strains ([`Self::undo_increment`],
+    /// [`Self::growth`]), and let every bond flip its branch again.
     pub fn begin_increment(&mut self) {
-        self.unlock_branches();
-        if self.start.len() == self.committed.len() {
-            self.start.copy_from_slice(&self.committed);
-            self.sps_start.copy_from_slice(&self.sps);
-        } else {
-            self.start = copied(&self.committed);
-            self.sps_start = copied(&self.sps);
-        }
+        self.flipped.iter_mut().for_each(|f| *f = 0);
+        self.start.copy_from_slice(&self.committed);
+        self.sps_start.copy_from_slice(&self.sps);
         self.shortened_start.clone_from(&self.shortened);
         if let Some(nb) = &mut self.neighbourhood {
             nb.strain_start.clone_from(&nb.strain);

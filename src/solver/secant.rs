@@ -65,8 +65,7 @@ const GROWTH_COARSEN: f64 = 0.01;
 const MIN_REFINE: f64 = 1.0 / 64.0;
 
 /// Cut-back: an increment in which some particle's damage grew by more than this is undone
-/// (`Concrete::undo_increment`, positions of the last converged increment) and taken again
-/// in half the step, down to MIN_REFINE.
+/// (`Concrete::undo_increment`) and taken again in half the step, down to MIN_REFINE.
 ///
 /// **Decision (measured, 2026-12-03).** The load is held while the state settles, so the
 /// peak is recorded only at an increment, and where a crack opens in one increment the
@@ -402,9 +401,8 @@ pub fn solve<const D: usize, const K: usize>(
                 .as_mut()
                 .expect("a model with state")
                 .undo_increment();
-            for ((x, x0), u) in sim.state.x.iter_mut().zip(&sim.x0).zip(&u1) {
-                *x = x0 + u;
-            }
+            // (the positions: the next pass sets every component, from the predictor or
+            // the ramp)
             time = time_before;
             converged_reaction2 = reaction2_before;
             refine *= 0.5;
