@@ -37,14 +37,16 @@ pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
 }
 
 /// Column names of increments.csv: one row per load increment of a relaxation or
-/// quasi-static run (`solver::relaxation::IncrementReport`).
-pub const INCREMENT_COLUMNS: [&str; 6] = [
+/// quasi-static run (`solver::relaxation::IncrementReport`); `opening_m` is the gauge
+/// opening held with `solver.control`, empty without.
+pub const INCREMENT_COLUMNS: [&str; 7] = [
     "increment",
     "load_factor",
     "iterations",
     "commits",
     "residual",
     "converged",
+    "opening_m",
 ];
 
 pub fn write_increments(
@@ -62,6 +64,7 @@ pub fn write_increments(
             r.commits.to_string(),
             format!("{:e}", r.residual),
             r.converged.to_string(),
+            r.opening_m.map(|o| format!("{o:e}")).unwrap_or_default(),
         ])?;
     }
     w.flush()?;

@@ -214,7 +214,42 @@ fn run_prepared<const K: usize, const D: usize>(
                 ramp: p.model.scene.loading.ramp,
                 stop_after_peak: p.model.scene.loading.stop_after_peak,
                 stop_unconverged: quasi_static.then(|| s.max_residual.unwrap_or(s.tolerance)),
+                control: s.control.as_ref().map(|c| {
+                    let mut gauge = Vec::new();
+                    for (name, sign) in [(&c.plus, 1.0), (&c.minus, -1.0)] {
+                        let members = &p
+                            .model
+                            .groups
+                            .iter()
+                            .find(|g| &g.name == name)
+                            .expect("solver.control names a group (validated)")
+                            .members;
+                        let w = sign / members.len() as f64;
+                        gauge.extend(
+                            members
+                                .iter()
+                                .map(|&i| (D * i as usize + c.component.index(), w)),
+                        );
+                    }
+                    relaxation::Control {
+                        gauge,
+                        opening: c.opening,
+                    }
+                }),
             };
+            if let Some(c) = &settings.control {
+                for p in &sim.prescribed {
+                    let d = D * p.particle as usize + p.component as usize;
+                    if c.gauge.iter().any(|&(g, _)| g == d) {
+                        return Err(RunError::Setup(format!(
+                            "solver.control: the gauge's particle {} (at {:?}) has its {} displacement prescribed by a group; the gauge must measure free displacements: choose its groups (solver.control.plus, solver.control.minus) away from the supports and the loaded rows",
+                            p.particle,
+                            sim.x0[p.particle as usize].as_slice(),
+                            ["x", "y", "z"][p.component as usize]
+                        )));
+                    }
+                }
+            }
             // scenes with damage: the implicit secant solver; elastic scenes have no state
             // to hold, and relax (docs/quasi_static.md)
             let implicit = quasi_static && sim.inelastic.is_some();

@@ -838,9 +838,28 @@ pub struct SolverSpec {
     /// "unconverged" (exit status 3).
     #[serde(default)]
     pub max_residual: Option<f64>,
+    /// Quasi-static: indirect displacement control on a crack opening (`solver::secant`,
+    /// docs/quasi_static.md). Left out, the prescribed displacement is the load path.
+    #[serde(default)]
+    pub control: Option<ControlSpec>,
 }
 
-/// How a run reaches the loaded state.
+/// Indirect displacement control: the load path is the opening of a gauge, the mean
+/// displacement of group `plus` less that of group `minus` in `component`, raised to
+/// `opening`; the prescribed displacements (the load groups' Δmax times a load factor) follow
+/// from equilibrium, and fall where the gauge opens while the body unloads (snap-back).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlSpec {
+    /// The group whose mean displacement counts positive.
+    pub plus: String,
+    /// The group whose mean displacement counts negative.
+    pub minus: String,
+    /// The gauge's direction.
+    pub component: Axis,
+    /// The opening at the end of the run (m).
+    pub opening: f64,
+}
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverMethod {
@@ -884,6 +903,7 @@ impl Default for SolverSpec {
             tolerance: default_tolerance(),
             max_iterations_key: None,
             max_residual: None,
+            control: None,
         }
     }
 }

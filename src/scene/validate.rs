@@ -1017,6 +1017,65 @@ impl Scene {
                 ));
             }
         }
+        if let Some(c) = &s.control {
+            if s.method != SolverMethod::QuasiStatic || self.concrete.is_none() {
+                return Err(invalid(
+                    "solver.control",
+                    format!("{{ plus = {:?}, minus = {:?} }}", c.plus, c.minus),
+                    format!("only with solver.method = \"quasi_static\" on a scene with [concrete] (here solver.method = \"{}\"{})", s.method.name(), if self.concrete.is_none() { ", no [concrete]" } else { "" }),
+                ));
+            }
+            for (key, name) in [
+                ("solver.control.plus", &c.plus),
+                ("solver.control.minus", &c.minus),
+            ] {
+                let Some(g) = self.groups.iter().find(|g| &g.name == name) else {
+                    let known: Vec<_> = self.groups.iter().map(|g| g.name.as_str()).collect();
+                    return Err(invalid(
+                        key,
+                        format!("{name:?}"),
+                        format!("one of the groups: {known:?}"),
+                    ));
+                };
+                if g.fix.contains(&c.component)
+                    || g.load.as_ref().is_some_and(|l| l.component == c.component)
+                {
+                    return Err(invalid(
+                        key,
+                        format!("{name:?}"),
+                        format!("a group whose {} displacement is free (the gauge measures the body, not a prescribed displacement): groups.{name} prescribes it", format!("{:?}", c.component).to_lowercase()),
+                    ));
+                }
+            }
+            if c.component.index() >= self.discretisation.dim() {
+                return Err(invalid(
+                    "solver.control.component",
+                    format!("{:?}", c.component).to_lowercase(),
+                    "\"x\" or \"y\" in 2D (\"z\" also in 3D)",
+                ));
+            }
+            if c.plus == c.minus {
+                return Err(invalid(
+                    "solver.control.minus",
+                    format!("{:?}", c.minus),
+                    "a group other than solver.control.plus",
+                ));
+            }
+            if !(c.opening.is_finite() && c.opening > 0.0 && c.opening < 1.0) {
+                return Err(invalid(
+                    "solver.control.opening",
+                    c.opening,
+                    "a gauge opening in metres, 0 < opening < 1",
+                ));
+            }
+            if !self.groups.iter().any(|g| g.load.is_some()) {
+                return Err(invalid(
+                    "solver.control",
+                    format!("{{ plus = {:?}, minus = {:?} }}", c.plus, c.minus),
+                    "a scene with a loaded group (its Δmax sets the direction of the prescribed displacements the control scales)",
+                ));
+            }
+        }
         if s.method.is_incremental() && s.force_lag == ForceLag::Previous {
             return Err(invalid(
                 "solver.force_lag",

@@ -53,7 +53,7 @@ use std::time::Instant;
 const CHUNK: usize = 2048;
 
 /// The relaxation keys of a scene (`[solver]`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Settings {
     pub increments: usize,
     pub tolerance: f64,
@@ -64,6 +64,18 @@ pub struct Settings {
     /// Stop at the first increment that ends above this out-of-balance ratio (quasi-static
     /// runs: `solver.max_residual`, else `tolerance`); `None` runs on (the relaxation).
     pub stop_unconverged: Option<f64>,
+    /// Indirect displacement control (`solver.control`; the quasi-static solver only).
+    pub control: Option<Control>,
+}
+
+/// A gauge opening as the load path (`solver.control`, `solver::secant`).
+#[derive(Clone, Debug, Default)]
+pub struct Control {
+    /// The gauge as weights on degrees of freedom D·i + component: the opening is
+    /// Σ w·(x − x0) over them.
+    pub gauge: Vec<(usize, f64)>,
+    /// The opening at the end of the run (m).
+    pub opening: f64,
 }
 
 /// How one load increment ended (`increments.csv`).
@@ -79,6 +91,8 @@ pub struct IncrementReport {
     pub commits: usize,
     /// ‖F_free‖₂ / ‖R‖₂ at its end.
     pub residual: f64,
+    /// The gauge opening held (m), with `solver.control`.
+    pub opening_m: Option<f64>,
     pub converged: bool,
 }
 

@@ -13,6 +13,11 @@
 //! every commit that changed the state. An increment in which damage jumped is undone and
 //! taken again in half the step ([`GROWTH_CUT`]).
 //!
+//! With `solver.control` the load path is a gauge's opening instead of the prescribed
+//! displacement, and the load factor λ that scales the prescribed displacements is solved for
+//! in each Newton step by bordering (docs/quasi_static.md, "Indirect control"); where the
+//! body unloads while the gauge opens, λ falls and the snap-back branch is followed.
+//!
 //! There is no pseudo-dynamics and no damper: the work of the prescribed displacements is
 //! booked by the trapezoid rule with the converged reactions, so the dissipated energy of
 //! the summary is W − U at equilibrium.
@@ -20,9 +25,14 @@
 use super::loading::ramp_fraction;
 use super::relaxation::{IncrementReport, Relaxed, Settings};
 use super::{PeakStop, Probe, Record, Simulation};
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
-use faer::Side;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
+use faer::{Par, Side};
 use nalgebra::SVector;
 use std::time::Instant;
 
@@ -75,11 +85,20 @@ const MIN_REFINE: f64 = 1.0 / 64.0;
 /// where it was.
 const GROWTH_CUT: f64 = 0.2;
 
+/// Free components from which the factorisation and solves run on faer's threads. Below it
+/// they run on one: on the split cylinder (1,602 unknowns) the threads' synchronisation made
+/// the run 10.4 s against 8.4 s on one thread (stop 35, one run each). Above it, faer's
+/// default (not measured here: the 2D scenes have at most 7,000 unknowns).
+const PARALLEL_DOFS: usize = 20_000;
+
 /// Free degrees of freedom and their columns.
 struct Dofs {
     /// Column of each degree of freedom D·i + c, `usize::MAX` where prescribed.
     column: Vec<usize>,
     count: usize,
+    /// Each degree of freedom's prescribed displacement at load factor 1 (Δmax; 0 where
+    /// free or held), with `solver.control` only (empty without).
+    amplitude: Vec<f64>,
 }
 
 impl Dofs {
@@ -97,88 +116,184 @@ impl Dofs {
                 count += 1;
             }
         }
-        Dofs { column, count }
+        Dofs {
+            column,
+            count,
+            amplitude: Vec::new(),
+        }
+    }
+
+    /// With indirect control: the amplitudes of the prescribed components.
+    fn with_amplitudes<const D: usize, const K: usize>(mut self, sim: &Simulation<D, K>) -> Self {
+        self.amplitude = vec![0.0; self.column.len()];
+        for p in &sim.prescribed {
+            self.amplitude[D * p.particle as usize + p.component as usize] = p.amplitude;
+        }
+        self
     }
 }
 
-/// The sparse pattern of the free-component stiffness, built once: which triplets of
-/// `concrete::secant_stiffness` it keeps, the value order and the symbolic Cholesky.
-struct Pattern {
-    /// Indices into the full triplet list of the entries between two free components.
-    keep: Vec<usize>,
-    symbolic: SymbolicSparseColMat<usize>,
-    argsort: Argsort<usize>,
-    llt: SymbolicLlt<usize>,
+/// The free-component stiffness: its lower triangle's pattern, the symbolic Cholesky and
+/// the numeric factor, all built once and refilled in place (no allocation per
+/// factorisation; measured at stop 35: the allocating `faer::sparse::linalg::solvers::Llt`
+/// spent most of its time in the allocator and the kernel's page faults).
+struct Factor {
+    /// The (row, column) of each triplet of `concrete::secant_stiffness` when the pattern
+    /// was built: a list of another length or order rebuilds it.
+    entries: Vec<(usize, usize)>,
+    /// Where each triplet goes in `values` (`usize::MAX`: a prescribed component).
+    slot: Vec<usize>,
+    /// Where each free component's diagonal is in `values`.
+    diagonal: Vec<usize>,
+    pattern: SymbolicSparseColMat<usize>,
     values: Vec<f64>,
+    symbolic: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+    memory: MemBuffer,
+    par: Par,
+    /// With indirect control: K⁻¹·q, the displacement of the free components per unit load
+    /// factor with the factor's stiffness (q = ∂F_free/∂λ = −K_fp·Δmax).
+    load: faer::Mat<f64>,
 }
-
-/// A factorised stiffness of the free degrees of freedom.
-struct Factor(Llt<usize, f64>);
 
 impl Factor {
-    fn new<const D: usize, const K: usize>(
-        sim: &Simulation<D, K>,
-        dofs: &Dofs,
-        pattern: &mut Option<Pattern>,
-    ) -> Result<Self, String> {
-        let model = sim.inelastic.as_ref().expect("a model with state");
-        let all = model.stiffness(&sim.mech, &sim.state.x);
-        if pattern
-            .as_ref()
-            .is_none_or(|p| p.values.len() != 2 * p.keep.len() + dofs.count)
-        {
-            let mut keep = Vec::new();
-            let mut pairs = Vec::new();
-            for (q, &(r, c, _)) in all.iter().enumerate() {
+    fn build(all: &[(usize, usize, f64)], dofs: &Dofs) -> Result<Self, String> {
+        let entries: Vec<(usize, usize)> = all.iter().map(|&(r, c, _)| (r, c)).collect();
+        let mut pairs = Vec::with_capacity(all.len() / 2 + dofs.count);
+        for &(r, c) in &entries {
+            let (cr, cc) = (dofs.column[r], dofs.column[c]);
+            if cr != usize::MAX && cc != usize::MAX && cr >= cc {
+                pairs.push(Pair::new(cr, cc));
+            }
+        }
+        pairs.extend((0..dofs.count).map(|c| Pair::new(c, c)));
+        let (pattern, _) =
+            SymbolicSparseColMat::try_new_from_indices(dofs.count, dofs.count, &pairs)
+                .map_err(|e| format!("the stiffness pattern could not be built: {e:?}"))?;
+        let position = |row: usize, col: usize| -> usize {
+            let (a, b) = (pattern.col_ptr()[col], pattern.col_ptr()[col + 1]);
+            a + pattern.row_idx()[a..b]
+                .binary_search(&row)
+                .expect("every entry is in the pattern")
+        };
+        let slot = entries
+            .iter()
+            .map(|&(r, c)| {
                 let (cr, cc) = (dofs.column[r], dofs.column[c]);
-                if cr != usize::MAX && cc != usize::MAX {
-                    keep.push(q);
-                    pairs.push(Pair::new(cr, cc));
-                    pairs.push(Pair::new(cc, cr));
+                if cr == usize::MAX || cc == usize::MAX {
+                    usize::MAX
+                } else {
+                    position(cr.max(cc), cr.min(cc))
                 }
-            }
-            pairs.extend((0..dofs.count).map(|c| Pair::new(c, c)));
-            let (symbolic, argsort) =
-                SymbolicSparseColMat::try_new_from_indices(dofs.count, dofs.count, &pairs)
-                    .map_err(|e| format!("the stiffness pattern could not be built: {e:?}"))?;
-            let llt = SymbolicLlt::try_new(symbolic.as_ref(), Side::Lower)
-                .map_err(|e| format!("the stiffness could not be analysed: {e:?}"))?;
-            let values = vec![0.0; pairs.len()];
-            *pattern = Some(Pattern {
-                keep,
-                symbolic,
-                argsort,
-                llt,
-                values,
-            });
-        }
-        let p = pattern.as_mut().expect("built above");
-        let mut largest: f64 = 0.0;
-        for (o, &q) in p.keep.iter().enumerate() {
-            let (r, c, v) = all[q];
-            if r == c {
-                largest = largest.max(v.abs());
-            }
-            // the symmetric part (the stiffness is symmetric on a lattice; weighted
-            // dilatations make it slightly less so, which Newton's residual corrects)
-            p.values[2 * o] = 0.5 * v;
-            p.values[2 * o + 1] = 0.5 * v;
-        }
-        let eps = REGULARISATION * largest.max(f64::MIN_POSITIVE);
-        let base = 2 * p.keep.len();
-        p.values[base..].iter_mut().for_each(|v| *v = eps);
-        let a =
-            SparseColMat::<usize, f64>::new_from_argsort(p.symbolic.clone(), &p.argsort, &p.values)
-                .map_err(|e| format!("the stiffness could not be assembled: {e:?}"))?;
-        let llt = Llt::try_new_with_symbolic(p.llt.clone(), a.as_ref(), Side::Lower)
-            .map_err(|e| format!("the secant stiffness is not positive definite ({e:?})"))?;
-        Ok(Factor(llt))
+            })
+            .collect();
+        let diagonal = (0..dofs.count).map(|c| position(c, c)).collect();
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| format!("the stiffness could not be analysed: {e:?}"))?;
+        let par = if dofs.count >= PARALLEL_DOFS {
+            faer::get_global_parallelism()
+        } else {
+            Par::Seq
+        };
+        let memory = MemBuffer::new(StackReq::any_of(&[
+            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, par),
+        ]));
+        Ok(Factor {
+            entries,
+            slot,
+            diagonal,
+            values: vec![0.0; pattern.compute_nnz()],
+            pattern,
+            l_values: vec![0.0; symbolic.len_val()],
+            symbolic,
+            memory,
+            par,
+            load: faer::Mat::zeros(dofs.count, 1),
+        })
     }
 
-    fn solve(&self, rhs: &mut faer::Mat<f64>) {
-        use faer::linalg::solvers::SolveCore;
-        self.0
-            .solve_in_place_with_conj(faer::Conj::No, rhs.as_mut());
+    /// Refactorise at the current positions (rebuilding the pattern if the stiffness's
+    /// entries changed).
+    fn refactorise<const D: usize, const K: usize>(
+        this: &mut Option<Self>,
+        sim: &Simulation<D, K>,
+        dofs: &Dofs,
+    ) -> Result<(), String> {
+        let model = sim.inelastic.as_ref().expect("a model with state");
+        let all = model.stiffness(&sim.mech, &sim.state.x);
+        let same = this.as_ref().is_some_and(|f| {
+            f.entries.len() == all.len()
+                && f.entries
+                    .iter()
+                    .zip(&all)
+                    .all(|(&(r, c), &(r2, c2, _))| r == r2 && c == c2)
+        });
+        if !same {
+            *this = Some(Factor::build(&all, dofs)?);
+        }
+        let f = this.as_mut().expect("built above");
+        f.values.iter_mut().for_each(|v| *v = 0.0);
+        let mut largest: f64 = 0.0;
+        for (&(r, c, v), &q) in all.iter().zip(&f.slot) {
+            if q == usize::MAX {
+                continue;
+            }
+            if r == c {
+                largest = largest.max(v.abs());
+                f.values[q] += v;
+            } else {
+                // the symmetric part (the stiffness is symmetric on a lattice; weighted
+                // dilatations make it slightly less so, which Newton's residual corrects)
+                f.values[q] += 0.5 * v;
+            }
+        }
+        let eps = REGULARISATION * largest.max(f64::MIN_POSITIVE);
+        for &q in &f.diagonal {
+            f.values[q] += eps;
+        }
+        let a = SparseColMatRef::new(f.pattern.as_ref(), &f.values);
+        f.symbolic
+            .factorize_numeric_llt(
+                &mut f.l_values,
+                a,
+                Side::Lower,
+                LltRegularization::default(),
+                f.par,
+                MemStack::new(&mut f.memory),
+                Default::default(),
+            )
+            .map_err(|e| format!("the secant stiffness is not positive definite ({e:?})"))?;
+        if !dofs.amplitude.is_empty() {
+            // q = −K_fp·Δmax (the symmetric part, as the factor), then K⁻¹·q
+            f.load.fill(0.0);
+            for &(r, c, v) in &all {
+                let (cr, cc) = (dofs.column[r], dofs.column[c]);
+                if cr != usize::MAX && cc == usize::MAX {
+                    f.load[(cr, 0)] -= 0.5 * v * dofs.amplitude[c];
+                } else if cr == usize::MAX && cc != usize::MAX {
+                    f.load[(cc, 0)] -= 0.5 * v * dofs.amplitude[r];
+                }
+            }
+            let mut load = std::mem::replace(&mut f.load, faer::Mat::zeros(0, 0));
+            f.solve(&mut load);
+            f.load = load;
+        }
+        Ok(())
+    }
+
+    fn solve(&mut self, rhs: &mut faer::Mat<f64>) {
+        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+            faer::Conj::No,
+            rhs.as_mut(),
+            self.par,
+            MemStack::new(&mut self.memory),
+        );
     }
 }
 
@@ -198,6 +313,18 @@ fn norms<const D: usize>(f: &[SVector<f64, D>], dofs: &Dofs) -> (f64, f64) {
     (free, reaction)
 }
 
+/// The gauge opening Σ w·(x − x0) of `solver.control`.
+fn gauge_opening<const D: usize>(
+    gauge: &[(usize, f64)],
+    x: &[SVector<f64, D>],
+    x0: &[SVector<f64, D>],
+) -> f64 {
+    gauge
+        .iter()
+        .map(|&(d, w)| w * (x[d / D][d % D] - x0[d / D][d % D]))
+        .sum()
+}
+
 /// Run the increments of a scene with damage (see the module doc). Returns what the
 /// relaxation returns, so the run, the summary and the outputs treat both alike.
 pub fn solve<const D: usize, const K: usize>(
@@ -206,7 +333,12 @@ pub fn solve<const D: usize, const K: usize>(
     s: &Settings,
     start: Instant,
 ) -> Relaxed {
-    let dofs = Dofs::new(sim);
+    let control = s.control.as_ref();
+    let dofs = if control.is_some() {
+        Dofs::new(sim).with_amplitudes(sim)
+    } else {
+        Dofs::new(sim)
+    };
     let mut stop = PeakStop::quasi_static(s.stop_after_peak, probe);
     let mut out = Relaxed {
         records: Vec::with_capacity(s.increments + 1),
@@ -231,11 +363,15 @@ pub fn solve<const D: usize, const K: usize>(
     let mut u1 = vec![SVector::<f64, D>::zeros(); n];
     let mut u2 = u1.clone();
     let (mut r1, mut r2) = (0.0, 0.0);
+    // the load path's value at the last two increments: the load factor, or with indirect
+    // control the gauge opening held
+    let (mut p1, mut p2) = (0.0, 0.0);
     let mut work = 0.0;
     let mut reaction_prev = vec![0.0; sim.prescribed.len()];
     let mut converged_reaction2: f64 = 0.0;
     let mut iterations = 0usize;
-    let mut pattern: Option<Pattern> = None;
+    // the stiffness's pattern, symbolic analysis and numeric factor, kept across increments
+    let mut factor: Option<Factor> = None;
     let record = |sim: &Simulation<D, K>,
                   f: &[SVector<f64, D>],
                   r: f64,
@@ -272,9 +408,21 @@ pub fn solve<const D: usize, const K: usize>(
         } else {
             time + refine * base
         };
-        let r = ramp_fraction(s.ramp, time, 1.0);
-        // predictor: the free components extrapolated from the last two increments
-        let alpha = if r1 > r2 { (r - r1) / (r1 - r2) } else { 0.0 };
+        let path = ramp_fraction(s.ramp, time, 1.0);
+        // with indirect control: the opening held; the load factor is then an unknown
+        let target = control.map(|c| c.opening * path);
+        let path = target.unwrap_or(path);
+        // predictor: the free components (and the load factor) extrapolated from the last
+        // two increments
+        let alpha = if p1 > p2 {
+            (path - p1) / (p1 - p2)
+        } else {
+            0.0
+        };
+        let mut r = match target {
+            None => path,
+            Some(_) => r1 + alpha * (r1 - r2),
+        };
         for i in 0..n {
             for c in 0..D {
                 if dofs.column[D * i + c] != usize::MAX {
@@ -293,9 +441,11 @@ pub fn solve<const D: usize, const K: usize>(
         let mut report = IncrementReport {
             increment: k,
             load_factor: r,
+            opening_m: target,
             ..Default::default()
         };
-        let mut factor: Option<Factor> = None;
+        // the numeric factor must be recomputed before the next solve
+        let mut refactor = true;
         let mut since_factor = 0;
         let mut since_commit = 0;
         let forces = loop {
@@ -315,7 +465,15 @@ pub fn solve<const D: usize, const K: usize>(
             } else {
                 0.0
             };
-            let balanced = free2 <= tol2 * scale || (scale == 0.0 && free2 == 0.0);
+            // with indirect control the gauge must hold its opening too (it does after every
+            // full Newton step: the constraint is linear)
+            let held = match (control, target) {
+                (Some(c), Some(t)) => {
+                    (gauge_opening(&c.gauge, &sim.state.x, &sim.x0) - t).abs() <= s.tolerance * t
+                }
+                _ => true,
+            };
+            let balanced = held && (free2 <= tol2 * scale || (scale == 0.0 && free2 == 0.0));
             if !report.residual.is_finite() {
                 report.converged = false;
                 break f;
@@ -336,16 +494,16 @@ pub fn solve<const D: usize, const K: usize>(
                     converged_reaction2 = converged_reaction2.max(reaction2);
                     break f;
                 }
-                factor = None;
+                refactor = true;
             }
             if report.iterations >= s.max_iterations {
                 report.converged = false;
                 break f;
             }
-            if factor.is_none() || since_factor >= NEWTON_PER_FACTOR {
-                match Factor::new(sim, &dofs, &mut pattern) {
-                    Ok(fa) => {
-                        factor = Some(fa);
+            if refactor || since_factor >= NEWTON_PER_FACTOR {
+                match Factor::refactorise(&mut factor, sim, &dofs) {
+                    Ok(()) => {
+                        refactor = false;
                         out.factorisations += 1;
                     }
                     Err(e) => {
@@ -373,7 +531,37 @@ pub fn solve<const D: usize, const K: usize>(
                     }
                 }
             }
-            factor.as_ref().expect("factorised").solve(&mut rhs);
+            let fa = factor.as_mut().expect("factorised");
+            fa.solve(&mut rhs);
+            // with indirect control, the load factor's change that makes the gauge hold
+            // its opening: Δx = K⁻¹F + Δλ·K⁻¹q with Σw·Δx = opening − c(x) (bordering)
+            let mut dr = 0.0;
+            if let (Some(c), Some(t)) = (control, target) {
+                let dot = |v: &faer::Mat<f64>| -> f64 {
+                    c.gauge
+                        .iter()
+                        .map(|&(d, w)| w * v[(dofs.column[d], 0)])
+                        .sum()
+                };
+                let (wa, wq) = (dot(&rhs), dot(&fa.load));
+                let miss = t - gauge_opening(&c.gauge, &sim.state.x, &sim.x0);
+                if wq == 0.0 || !wq.is_finite() {
+                    out.failure = Some(super::Unstable {
+                        step: iterations + report.iterations,
+                        time: r,
+                        particle: 0,
+                        position: String::new(),
+                        what: format!("the gauge of solver.control no longer responds to the load (d opening / d load factor = {wq:.3e} m): the body has separated between the load and the gauge; end the run at a smaller solver.control.opening"),
+                        increment: Some(out.increments.len() + 1),
+                    });
+                    out.increments.push(report);
+                    break 'increments;
+                }
+                dr = (miss - wa) / wq;
+                for col in 0..dofs.count {
+                    rhs[(col, 0)] += dr * fa.load[(col, 0)];
+                }
+            }
             let largest = (0..dofs.count)
                 .map(|c| rhs[(c, 0)].abs())
                 .fold(0.0, f64::max);
@@ -390,8 +578,16 @@ pub fn solve<const D: usize, const K: usize>(
                     }
                 }
             }
+            if target.is_some() {
+                r += scale * dr;
+                for p in &sim.prescribed {
+                    let (i, c) = (p.particle as usize, p.component as usize);
+                    sim.state.x[i][c] = sim.x0[i][c] + p.amplitude * r;
+                }
+            }
             since_factor += 1;
         };
+        report.load_factor = r;
         let growth = sim.inelastic.as_ref().expect("a model with state").growth();
         iterations += report.iterations;
         out.iterations = iterations;
@@ -435,6 +631,8 @@ pub fn solve<const D: usize, const K: usize>(
         }
         r2 = r1;
         r1 = r;
+        p2 = p1;
+        p1 = path;
         // smaller steps while damage grows, back to the scene's once it stops
         if growth > GROWTH_REFINE {
             refine = (refine * 0.5).max(MIN_REFINE);

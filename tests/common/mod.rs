@@ -132,10 +132,9 @@ pub fn measure_e_nu<const K: usize>(
     (sigma / eyy, -exx / eyy)
 }
 
-/// A block 150 mm wide, `height` high, 150 mm thick, of the Table 1 concrete, pulled at the
-/// top rows by 1.5·COD_c (the default), held at the bottom rows, one particle held in x.
-pub fn tension_block(height: f64, spacing: f64, overrides: &[&str]) -> Scene {
-    let text = format!(
+/// The TOML text of [`tension_block`].
+pub fn tension_block_toml(height: f64, spacing: f64) -> String {
+    format!(
         r#"
 name = "block"
 [body]
@@ -172,7 +171,13 @@ external = 0.2
 [output]
 records = 400
 "#
-    );
+    )
+}
+
+/// A block 150 mm wide, `height` high, 150 mm thick, of the Table 1 concrete, pulled at the
+/// top rows by 1.5·COD_c (the default), held at the bottom rows, one particle held in x.
+pub fn tension_block(height: f64, spacing: f64, overrides: &[&str]) -> Scene {
+    let text = tension_block_toml(height, spacing);
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     Scene::from_toml_str(&text, &o).unwrap()
 }
