@@ -162,30 +162,71 @@ impl PeakStop {
 /// A run that went unstable, or whose quasi-static solve broke down.
 #[derive(Debug)]
 pub struct Unstable {
-    /// The step; for the quasi-static solver, the Newton iteration counted over the run.
-    pub step: usize,
-    /// The time (s); for the quasi-static solver, the load factor.
-    pub time: f64,
-    pub particle: usize,
-    pub position: String,
+    /// Where it happened.
+    pub at: Location,
     pub what: String,
-    /// `Some(n)`: the quasi-static solver's increment n (1-based) could not be solved; no
-    /// particle is named (the failure is the whole stiffness's).
-    pub increment: Option<usize>,
 }
+
+/// Where a run stopped: an explicit step at a particle, or a quasi-static increment.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Location {
+    /// The explicit step just taken and the particle found failing, with its reference
+    /// position.
+    Step {
+        step: usize,
+        /// The time (s).
+        time: f64,
+        particle: usize,
+        position: String,
+    },
+    /// The quasi-static solver's increment (1-based) that could not be solved: the failure
+    /// is the whole stiffness's (or the gauge's), so no particle is named.
+    Increment {
+        increment: usize,
+        load_factor: f64,
+        /// The Newton iteration counted over the run.
+        iteration: usize,
+        /// What to change.
+        remedy: &'static str,
+    },
+}
+
+impl Unstable {
+    /// The explicit step, or the quasi-static solver's Newton iteration counted over the run.
+    pub fn step(&self) -> usize {
+        match self.at {
+            Location::Step { step, .. } => step,
+            Location::Increment { iteration, .. } => iteration,
+        }
+    }
+}
+
+/// The remedy of a held stiffness that cannot be factorised.
+pub const STIFFNESS_REMEDY: &str =
+    "raise solver.increments (less damage grows in each), or run solver.method = \"explicit\"";
 
 impl std::fmt::Display for Unstable {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.increment {
-            None => write!(
+        match &self.at {
+            Location::Step {
+                step,
+                time,
+                particle,
+                position,
+            } => write!(
                 f,
-                "the run went unstable at step {} (t = {:.6e} s): {} at particle {} (reference position {}); reduce solver.safety or solver.dt, or check the material and the loading",
-                self.step, self.time, self.what, self.particle, self.position
+                "the run went unstable at step {step} (t = {time:.6e} s): {} at particle {particle} (reference position {position}); reduce solver.safety or solver.dt, or check the material and the loading",
+                self.what
             ),
-            Some(n) => write!(
+            Location::Increment {
+                increment,
+                load_factor,
+                iteration,
+                remedy,
+            } => write!(
                 f,
-                "the quasi-static solver stopped at increment {n} (load factor {:.6}, iteration {} of the run): {}; raise solver.increments (less damage grows in each), or run solver.method = \"explicit\"",
-                self.time, self.step, self.what
+                "the quasi-static solver stopped at increment {increment} (load factor {load_factor:.6}, iteration {iteration} of the run): {}; {remedy}",
+                self.what
             ),
         }
     }
@@ -576,31 +617,33 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             }
         };
         Err(Unstable {
-            step: self.step,
-            time: self.time(),
-            particle,
-            position: format!("{:?}", self.x0[particle].as_slice()),
+            at: Location::Step {
+                step: self.step,
+                time: self.time(),
+                particle,
+                position: format!("{:?}", self.x0[particle].as_slice()),
+            },
             what,
-            increment: None,
         })
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::Unstable;
+    use super::{Location, Unstable, STIFFNESS_REMEDY};
 
     /// A quasi-static breakdown names the increment and load factor and the keys that apply
     /// to that solver, not the explicit step's (solver.safety, solver.dt) nor a particle.
     #[test]
     fn quasi_static_breakdown_names_the_increment_and_its_remedy() {
         let e = Unstable {
-            step: 812,
-            time: 0.4375,
-            particle: 0,
-            position: String::new(),
+            at: Location::Increment {
+                increment: 57,
+                load_factor: 0.4375,
+                iteration: 812,
+                remedy: STIFFNESS_REMEDY,
+            },
             what: "the secant stiffness is not positive definite".into(),
-            increment: Some(57),
         };
         let msg = e.to_string();
         assert!(
@@ -613,7 +656,12 @@ mod tests {
             "{msg}"
         );
         let explicit = Unstable {
-            increment: None,
+            at: Location::Step {
+                step: 812,
+                time: 0.4375,
+                particle: 0,
+                position: "[0.0, 0.0]".into(),
+            },
             ..e
         };
         let msg = explicit.to_string();

@@ -24,7 +24,7 @@
 
 use super::loading::ramp_fraction;
 use super::relaxation::{IncrementReport, Relaxed, Settings};
-use super::{PeakStop, Probe, Record, Simulation};
+use super::{Location, PeakStop, Probe, Record, Simulation};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
@@ -84,6 +84,9 @@ const MIN_REFINE: f64 = 1.0 / 64.0;
 /// at −1.1% and −0.15% (docs/quasi_static.md). 0.5 instead of 0.2 left the tension block
 /// where it was.
 const GROWTH_CUT: f64 = 0.2;
+
+/// The remedy of a gauge that stopped responding to the load (`solver.control`).
+const GAUGE_REMEDY: &str = "end the run at a smaller solver.control.opening, or put the gauge where the load still reaches it";
 
 /// Free components from which the factorisation and solves run on faer's threads. Below it
 /// they run on one: on the split cylinder (1,602 unknowns) the threads' synchronisation made
@@ -508,12 +511,13 @@ pub fn solve<const D: usize, const K: usize>(
                     }
                     Err(e) => {
                         out.failure = Some(super::Unstable {
-                            step: iterations + report.iterations,
-                            time: r,
-                            particle: 0,
-                            position: String::new(),
+                            at: Location::Increment {
+                                increment: out.increments.len() + 1,
+                                load_factor: r,
+                                iteration: iterations + report.iterations,
+                                remedy: super::STIFFNESS_REMEDY,
+                            },
                             what: e,
-                            increment: Some(out.increments.len() + 1),
                         });
                         out.increments.push(report);
                         break 'increments;
@@ -547,12 +551,13 @@ pub fn solve<const D: usize, const K: usize>(
                 let miss = t - gauge_opening(&c.gauge, &sim.state.x, &sim.x0);
                 if wq == 0.0 || !wq.is_finite() {
                     out.failure = Some(super::Unstable {
-                        step: iterations + report.iterations,
-                        time: r,
-                        particle: 0,
-                        position: String::new(),
-                        what: format!("the gauge of solver.control no longer responds to the load (d opening / d load factor = {wq:.3e} m): the body has separated between the load and the gauge; end the run at a smaller solver.control.opening"),
-                        increment: Some(out.increments.len() + 1),
+                        at: Location::Increment {
+                            increment: out.increments.len() + 1,
+                            load_factor: r,
+                            iteration: iterations + report.iterations,
+                            remedy: GAUGE_REMEDY,
+                        },
+                        what: format!("the gauge of solver.control no longer responds to the load (d opening / d load factor = {wq:.3e} m): the body has separated, or crushed, between the load and the gauge"),
                     });
                     out.increments.push(report);
                     break 'increments;
