@@ -195,6 +195,12 @@ fn crack_opening_control_converges_and_reaches_ft_and_gf() {
     assert!(back >= 1, "no increment with the load factor falling");
     let last = out.increments.last().unwrap();
     assert!((last.opening_m.unwrap() / 1.5e-4 - 1.0).abs() < 1e-12);
+    // the summary records the gauge
+    let c = sm.control.as_ref().expect("summary.control");
+    assert_eq!(
+        (c.plus.as_str(), c.minus.as_str(), c.opening),
+        ("gauge_top", "gauge_bottom", 1.5e-4)
+    );
     assert!(sm.max_damage.unwrap() >= 0.99, "the block did not crack");
     assert_ft_and_gf(sm, fta, gfa);
 }

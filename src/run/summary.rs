@@ -47,6 +47,9 @@ pub struct Summary {
     /// Quasi-static with damage: increments undone and taken again in half the step because
     /// damage jumped in them (their iterations are counted in `iterations`).
     pub cutbacks: Option<usize>,
+    /// Quasi-static with indirect control: the gauge (`solver.control`: plus, minus,
+    /// component, opening in m); the increments' openings are in increments.csv.
+    pub control: Option<crate::scene::ControlSpec>,
     /// The run stopped after its peak (`loading.stop_after_peak`), before t_end.
     pub stopped_after_peak: bool,
     pub threads: usize,
@@ -323,6 +326,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         commits: report.commits,
         factorisations: report.factorisations,
         cutbacks: report.cutbacks,
+        control: p.model.scene.solver.control.clone(),
         stopped_after_peak: report.stopped_after_peak,
         threads,
         probe_group: p.probe.as_ref().map(|(n, _)| n.clone()),
