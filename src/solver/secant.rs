@@ -283,21 +283,49 @@ impl Factor {
                     f.load[(cc, 0)] -= 0.5 * v * dofs.amplitude[r];
                 }
             }
-            let mut load = std::mem::replace(&mut f.load, faer::Mat::zeros(0, 0));
-            f.solve(&mut load);
-            f.load = load;
+            f.solve_load();
         }
         Ok(())
     }
 
     fn solve(&mut self, rhs: &mut faer::Mat<f64>) {
-        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
-            faer::Conj::No,
-            rhs.as_mut(),
+        llt_solve(
+            &self.symbolic,
+            &self.l_values,
             self.par,
-            MemStack::new(&mut self.memory),
+            &mut self.memory,
+            rhs,
         );
     }
+
+    /// K⁻¹·q into `load` (in place; `load` holds q on entry).
+    fn solve_load(&mut self) {
+        let Factor {
+            symbolic,
+            l_values,
+            par,
+            memory,
+            load,
+            ..
+        } = self;
+        llt_solve(symbolic, l_values, *par, memory, load);
+    }
+}
+
+/// Solve L·Lᵀ·x = rhs in place with the factor's values and workspace.
+fn llt_solve(
+    symbolic: &SymbolicCholesky<usize>,
+    l_values: &[f64],
+    par: Par,
+    memory: &mut MemBuffer,
+    rhs: &mut faer::Mat<f64>,
+) {
+    LltRef::new(symbolic, l_values).solve_in_place_with_conj(
+        faer::Conj::No,
+        rhs.as_mut(),
+        par,
+        MemStack::new(memory),
+    );
 }
 
 /// The out-of-balance force on the free components and the reactions, squared norms.
@@ -375,6 +403,8 @@ pub fn solve<const D: usize, const K: usize>(
     let mut iterations = 0usize;
     // the stiffness's pattern, symbolic analysis and numeric factor, kept across increments
     let mut factor: Option<Factor> = None;
+    // the Newton step's right-hand side and solution, reused
+    let mut rhs = faer::Mat::<f64>::zeros(dofs.count, 1);
     let record = |sim: &Simulation<D, K>,
                   f: &[SVector<f64, D>],
                   r: f64,
@@ -526,7 +556,6 @@ pub fn solve<const D: usize, const K: usize>(
                 since_factor = 0;
             }
             // Newton: K·Δx = F on the free components
-            let mut rhs = faer::Mat::<f64>::zeros(dofs.count, 1);
             for (i, fi) in f.iter().enumerate() {
                 for c in 0..D {
                     let col = dofs.column[D * i + c];
