@@ -390,6 +390,89 @@ pub fn bench_fcc(
     })
 }
 
+/// `sppm bench --dim 3 --lattice random`: random particles (SPPM, `discretise::random3`) in a
+/// cube of about `particles` particles at the FCC density (L0 = 1 mm, seed 1), with each
+/// particle's least-squares (a, b) for E = 30 GPa, ν = 0.2; the elastic slot kernel (bond
+/// dampers on) under a homogeneous strain of 1e-4. The set-up's seconds (placement, clipped
+/// Voronoi cells, bonds, moduli) are reported beside the throughput.
+pub fn bench_random3(
+    particles: usize,
+    steps: usize,
+    threads: usize,
+    kernel: KernelSet,
+) -> anyhow::Result<BenchResult> {
+    use crate::discretise::random3::{self, RandomSolid, SLOTS_3D};
+    anyhow::ensure!(
+        kernel == KernelSet::Elastic,
+        "--model {} with --dim 3 --lattice random: the 3D random benchmark runs the elastic kernel",
+        kernel.name()
+    );
+    let l0 = 1e-3;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+    let side = (particles as f64 * 0.5 * 2f64.sqrt()).cbrt() * l0;
+    let shape = crate::geometry::Shape3::Box {
+        origin: Vector3::zeros(),
+        size: Vector3::repeat(side),
+    };
+    let recipe = RandomSolid {
+        spacing: l0,
+        min_distance: random::DEFAULT_MIN_DISTANCE,
+        seed: 1,
+        rotation_deg: [0.0; 3],
+    };
+    let (p, setup) = pool.install(|| -> anyhow::Result<_> {
+        let (mut p, g) = random3::fill::<SLOTS_3D>(&shape, &recipe)
+            .map_err(|e| anyhow::anyhow!("random particles: {e}"))?;
+        let t = Instant::now();
+        let d =
+            <crate::model::dimension::Dim<3> as crate::model::dimension::Dimension<3>>::elasticity(
+                30e9,
+                0.2,
+                Plane::Stress,
+            );
+        let (mut a, mut b) = (std::mem::take(&mut p.a), std::mem::take(&mut p.b));
+        let fit = crate::run::prepare::fit_moduli_3d(&p, &d, &mut a, &mut b);
+        anyhow::ensure!(
+            fit.unfitted == 0,
+            "{} particles have no moduli fit",
+            fit.unfitted
+        );
+        p.a = a;
+        p.b = b;
+        let setup = Setup {
+            placing_s: g.seconds_placing,
+            voronoi_s: g.seconds_voronoi,
+            bonding_s: g.seconds_bonding,
+            moduli_s: t.elapsed().as_secs_f64(),
+        };
+        Ok((p, setup))
+    })?;
+    let n = p.len();
+    let (mech, mut st) = strained_model(&p, kernel);
+    let dt = 0.9 * pool.install(|| crate::solver::time_step::stable_step(&mech, &p.x0).dt_stable);
+    drop(p);
+    let seconds = timed(&pool, steps, || {
+        kernel::step::<3, SLOTS_3D, false, true>(&mech, &mut st, dt);
+        std::mem::swap(&mut st.x, &mut st.x_next);
+        std::mem::swap(&mut st.v, &mut st.v_next);
+    });
+    Ok(BenchResult {
+        particles: n,
+        steps,
+        threads,
+        model: kernel.name().into(),
+        layout: Layout::Slots.name().into(),
+        particle_steps_per_s: (n * steps) as f64 / seconds,
+        seconds,
+        lattice: "random".into(),
+        bytes_per_particle: crate::discretise::bytes_per_particle(3, SLOTS_3D),
+        simd: true,
+        setup: Some(setup),
+    })
+}
+
 /// Seconds `steps` calls of `one_step` take on `pool`, after two untimed ones.
 fn timed(pool: &rayon::ThreadPool, steps: usize, mut one_step: impl FnMut() + Send) -> f64 {
     pool.install(|| {

@@ -183,7 +183,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     eprintln!("[{:7.1} s] {what}…", started.elapsed().as_secs_f64());
                 }
             };
-            if sc.discretisation.dim() == 3 {
+            if sc.dim() == 3 && sc.discretisation.is_random() {
+                let p = sppm::run::solid::prepare_random_solid(&sc, &stage)?;
+                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
+            } else if sc.dim() == 3 {
                 let p = sppm::run::solid::prepare_solid(&sc, &stage)?;
                 check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
             } else if sppm::run::prepare::slots_of(&sc) == sppm::discretise::random::SLOTS_2D {
@@ -238,8 +241,8 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     layout.name()
                 );
                 anyhow::ensure!(
-                    lattice == "hexagonal" || lattice == "fcc",
-                    "--lattice {lattice} with --dim 3: the 3D benchmark runs the FCC lattice (\"fcc\")"
+                    ["hexagonal", "fcc", "random"].contains(&lattice.as_str()),
+                    "--lattice {lattice} with --dim 3: \"fcc\" (the FCC lattice) or \"random\" (random particles, elastic kernel)"
                 );
             }
             anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
@@ -254,7 +257,9 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 threads <= 4096,
                 "--threads {threads}: at most 4096 worker threads"
             );
-            let r = if dim == 3 {
+            let r = if dim == 3 && lattice == "random" {
+                sppm::bench::bench_random3(particles, steps.max(1), threads, kernel)
+            } else if dim == 3 {
                 sppm::bench::bench_fcc(particles, steps.max(1), threads, kernel, !scalar)
             } else {
                 sppm::bench::bench(
@@ -364,7 +369,7 @@ fn check<const K: usize, const D: usize>(
     if let Some(r) = &p.model.random {
         let g = &r.generation;
         say!(
-            "random particles {} ({} on the outline; the density of a hexagonal lattice: {})",
+            "random particles {} ({} on the boundary; the lattice's density: {})",
             g.particles,
             g.outline_particles,
             g.target

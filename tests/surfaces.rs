@@ -39,7 +39,7 @@ fn every_shipped_body_carries_its_mass_at_any_rotation_and_offset() {
             continue;
         }
         let l0 = base.discretisation.spacing;
-        if base.discretisation.dim() == 3 {
+        if base.dim() == 3 {
             // a 3D body (FCC): three angles, three offsets
             for rot in [
                 [0.0, 0.0, 0.0],

@@ -14,6 +14,7 @@ pub mod fcc;
 pub mod groups;
 pub mod hex;
 pub mod random;
+pub mod random3;
 pub mod voronoi;
 pub mod voronoi3;
 

@@ -237,22 +237,34 @@ pub fn bond<const K: usize>(
     x: &[P],
     shape: &Shape2,
 ) -> Result<(Vec<[u32; K]>, Vec<[u8; K]>, Vec<[f64; K]>), String> {
-    let tree: RTree<GeomWithData<[f64; 2], u32>> = RTree::bulk_load(
-        x.iter()
-            .enumerate()
-            .map(|(i, p)| GeomWithData::new([p.x, p.y], i as u32))
-            .collect(),
-    );
     let tol = 1e-9 * shape.size();
     // seven points along the bond: a bond of up to twice the spacing cannot step over a
     // notch of the outline wider than a quarter of the spacing; cutouts are tested exactly
-    let inside = |a: &P, b: &P| shape.segment_in_body(a, b, tol, 8);
-    let mut lists: Vec<Vec<u32>> = vec![Vec::with_capacity(8); x.len()];
+    bond_nearest::<2, K>(x, NEAREST_2D, |a, b| shape.segment_in_body(a, b, tol, 8))
+}
+
+/// Bond every particle of `x` to its `nearest` nearest particles where `inside` accepts the
+/// segment, a bond existing where either end lists the other (3.50), into `K` slots:
+/// neighbours, reverse slots, reference lengths (2D and 3D random bodies). A particle with
+/// more than `K` bonds is an error.
+#[allow(clippy::type_complexity)]
+pub fn bond_nearest<const D: usize, const K: usize>(
+    x: &[nalgebra::SVector<f64, D>],
+    nearest: usize,
+    inside: impl Fn(&nalgebra::SVector<f64, D>, &nalgebra::SVector<f64, D>) -> bool,
+) -> Result<(Vec<[u32; K]>, Vec<[u8; K]>, Vec<[f64; K]>), String> {
+    let tree: RTree<GeomWithData<[f64; D], u32>> = RTree::bulk_load(
+        x.iter()
+            .enumerate()
+            .map(|(i, p)| GeomWithData::new(p.data.0[0], i as u32))
+            .collect(),
+    );
+    let mut lists: Vec<Vec<u32>> = vec![Vec::with_capacity(2 * nearest); x.len()];
     for (i, p) in x.iter().enumerate() {
         for q in tree
-            .nearest_neighbor_iter(&[p.x, p.y])
+            .nearest_neighbor_iter(&p.data.0[0])
             .filter(|q| q.data as usize != i)
-            .take(NEAREST_2D)
+            .take(nearest)
         {
             let j = q.data;
             if inside(p, &x[j as usize]) {
@@ -269,9 +281,8 @@ pub fn bond<const K: usize>(
         l.dedup();
         if l.len() > K {
             return Err(format!(
-                "particle {i} at ({:.6}, {:.6}) m has {} bonds, more than the {K} slots of a random body",
-                x[i].x,
-                x[i].y,
+                "particle {i} at {:?} m has {} bonds, more than the {K} slots of a random body",
+                x[i].as_slice(),
                 l.len()
             ));
         }
@@ -322,12 +333,33 @@ pub fn fill<const K: usize>(
             p.x0[i].x, p.x0[i].y
         ));
     }
-    // The statistics, while `length` still holds each particle's shortest bond.
+    let generation = measure(
+        &mut p,
+        recipe.min_distance,
+        on_outline,
+        target_count(shape, recipe.spacing),
+        [t0, t1, t2, t3],
+    );
+    Ok((p, polygons, generation))
+}
+
+/// What generation measured of a random body (2D or 3D) whose `length` still holds each
+/// particle's shortest bond: the bond histogram and nearest distances; then each particle's
+/// length scale becomes its mean bond length (the lattice's shortest bond is its only one:
+/// ω_i and the crack band read it). `times`: the instants before placing, after placing,
+/// after the cells and after bonding.
+pub fn measure<const D: usize, const K: usize>(
+    p: &mut Particles<D, K>,
+    min_distance: f64,
+    on_outline: usize,
+    target: usize,
+    times: [std::time::Instant; 4],
+) -> Generation {
     let mut hist = vec![0usize; K + 1];
     let (mut nmin, mut nsum, mut nmax) = (f64::INFINITY, 0.0, 0.0f64);
     for i in 0..p.len() {
         hist[p.bond_count(i)] += 1;
-        let near = p.length[i] / recipe.spacing;
+        let near = p.length[i] / p.spacing;
         nmin = nmin.min(near);
         nmax = nmax.max(near);
         nsum += near;
@@ -335,8 +367,6 @@ pub fn fill<const K: usize>(
     while hist.last() == Some(&0) {
         hist.pop();
     }
-    // A random particle's length scale is its mean bond length (the lattice's shortest bond
-    // is its only one): ω_i and the crack band read it.
     for i in 0..p.len() {
         let (mut sum, mut count) = (0.0, 0);
         for k in 0..K {
@@ -347,11 +377,12 @@ pub fn fill<const K: usize>(
         }
         p.length[i] = sum / count as f64;
     }
-    let generation = Generation {
-        min_distance: recipe.min_distance,
+    let [t0, t1, t2, t3] = times;
+    Generation {
+        min_distance,
         particles: p.len(),
         outline_particles: on_outline,
-        target: target_count(shape, recipe.spacing),
+        target,
         nearest_min: nmin,
         nearest_mean: nsum / p.len() as f64,
         nearest_max: nmax,
@@ -359,8 +390,7 @@ pub fn fill<const K: usize>(
         seconds_placing: (t1 - t0).as_secs_f64(),
         seconds_voronoi: (t2 - t1).as_secs_f64(),
         seconds_bonding: (t3 - t2).as_secs_f64(),
-    };
-    Ok((p, polygons, generation))
+    }
 }
 
 #[cfg(test)]

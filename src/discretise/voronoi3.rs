@@ -146,6 +146,119 @@ pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> 
     }
 }
 
+/// The Voronoi cell volumes of any particle set in `shape` (random particles, SPPM in 3D;
+/// 002 (3.53) without its sphere approximation), each cell clipped to the body: exactly by
+/// the planes of a box; for a prism or a cylinder by slicing along the axis
+/// ([`volume_in_section`]). The cells tile the body, so the volumes sum to its volume (the
+/// tests: within 1e-9 on a box, a cylinder and the dog-bone prism). `spacing`: the mean
+/// spacing L0, the scale of the cells' first guess of their reach.
+pub fn clipped_volumes(x: &[P], shape: &Shape3, spacing: f64) -> Vec<f64> {
+    match shape.sweep() {
+        Some(sweep) => {
+            let q: Vec<P> = x.iter().map(|x| sweep.local(x)).collect();
+            let (section, length) = (&sweep.section, sweep.length);
+            let (lo, hi) = section.bounding_box();
+            let pad = 1e-3 * section.size().max(length);
+            let bounds = ConvexPolyhedron::cuboid(
+                P::new(lo.x - pad, lo.y - pad, 0.0),
+                P::new(hi.x + pad, hi.y + pad, length),
+            );
+            let tree = tree_of(&q);
+            let tol = 1e-12 * spacing.powi(3);
+            (0..q.len())
+                .into_par_iter()
+                .map(|i| {
+                    let cell = nearest_first_cell(&q, i, &tree, &bounds, 2.0 * spacing);
+                    let xy = Vector2::new(q[i].x, q[i].y);
+                    let depth = if section.contains(&xy, 0.0) {
+                        section.boundary_distance(&xy)
+                    } else {
+                        0.0
+                    };
+                    // a cell whose projection lies in the section keeps its clipped volume
+                    let radius_xy = cell
+                        .faces
+                        .iter()
+                        .flatten()
+                        .map(|v| (Vector2::new(v.x, v.y) - xy).norm())
+                        .fold(0.0, f64::max);
+                    if depth > radius_xy * (1.0 + 1e-9) {
+                        cell.volume()
+                    } else {
+                        volume_in_section(&cell, section, tol)
+                    }
+                })
+                .collect()
+        }
+        None => {
+            let planes = shape.planes().expect("a convex polyhedral body");
+            let (lo, hi) = shape.bounding_box();
+            let pad = P::repeat(1e-3 * shape.size());
+            let body = ConvexPolyhedron::from_planes(&planes, lo - pad, hi + pad);
+            let tree = tree_of(x);
+            (0..x.len())
+                .into_par_iter()
+                .map(|i| nearest_first_cell(x, i, &tree, &body, 2.0 * spacing).volume())
+                .collect()
+        }
+    }
+}
+
+/// The Voronoi cell of particle i within the convex `bounds`, clipped by the bisector planes
+/// of its neighbours nearest first until the next one lies farther than twice the cell's
+/// radius (it cannot cut the cell then). The cell starts as `bounds` cut to a cube of
+/// half-width `reach` about the particle, and is built again with twice the reach where it
+/// touches that cube (its radius reaches `reach`), so the cube never shapes a cell.
+fn nearest_first_cell(
+    x: &[P],
+    i: usize,
+    tree: &RTree<GeomWithData<[f64; 3], usize>>,
+    bounds: &ConvexPolyhedron,
+    reach: f64,
+) -> ConvexPolyhedron {
+    let xi = x[i];
+    let radius_of = |c: &ConvexPolyhedron| {
+        c.faces
+            .iter()
+            .flatten()
+            .map(|v| (v - xi).norm_squared())
+            .fold(0.0, f64::max)
+            .sqrt()
+    };
+    let mut reach = reach;
+    loop {
+        let mut cell = bounds.clone();
+        for d in 0..3 {
+            let e = P::from_fn(|k, _| if k == d { 1.0 } else { 0.0 });
+            cell.clip(&e, xi[d] + reach);
+            cell.clip(&-e, -(xi[d] - reach));
+        }
+        // the radius is recomputed only where the last one would let the search stop: clips
+        // only shrink the cell, so a stale radius errs on the side of clipping more
+        let mut radius = radius_of(&cell);
+        let mut since = 0;
+        for (o, d2) in tree.nearest_neighbor_iter_with_distance_2(&[xi.x, xi.y, xi.z]) {
+            if o.data == i {
+                continue;
+            }
+            if d2 > 4.0 * radius * radius || since >= 8 {
+                radius = radius_of(&cell);
+                since = 0;
+                if d2 > 4.0 * radius * radius {
+                    break;
+                }
+            }
+            let d = x[o.data] - xi;
+            cell.clip(&d, d.dot(&(xi + d * 0.5)));
+            since += 1;
+        }
+        if radius_of(&cell) < reach * (1.0 - 1e-9) {
+            return cell;
+        }
+        reach *= 2.0;
+    }
+}
+
 /// An R-tree of points, each with its index.
 fn tree_of(x: &[P]) -> RTree<GeomWithData<[f64; 3], usize>> {
     RTree::bulk_load(

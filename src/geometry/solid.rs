@@ -58,6 +58,12 @@ impl Sweep {
     pub fn local(&self, x: &Vector3<f64>) -> Vector3<f64> {
         self.axes * (x - self.origin)
     }
+
+    /// The position of local coordinates (u, v, w): the inverse of [`Sweep::local`].
+    #[inline]
+    pub fn global(&self, q: &Vector3<f64>) -> Vector3<f64> {
+        self.origin + self.axes.transpose() * q
+    }
 }
 
 impl Shape3 {
@@ -188,6 +194,24 @@ impl Shape3 {
                     ]),
                 })
             }
+        }
+    }
+
+    /// The body as a section swept along an axis, the box included (its rectangle in x, y
+    /// along z): what the surface of random particles is sampled on (`discretise::random3`).
+    pub fn as_sweep(&self) -> Sweep {
+        match self {
+            Shape3::Box { origin, size } => Sweep {
+                section: Shape2::Rectangle {
+                    origin: Vector2::new(origin.x, origin.y),
+                    width: size.x,
+                    height: size.y,
+                },
+                length: size.z,
+                origin: Vector3::new(0.0, 0.0, origin.z),
+                axes: nalgebra::Matrix3::identity(),
+            },
+            _ => self.sweep().expect("a prism or a cylinder is a sweep"),
         }
     }
 

@@ -66,7 +66,10 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
         .build()
         .map_err(|e| RunError::Setup(format!("cannot start {threads} threads: {e}")))?;
     pool.install(|| {
-        if scene.discretisation.dim() == 3 {
+        if scene.dim() == 3 && scene.discretisation.is_random() {
+            let p = super::solid::prepare_random_solid(scene, &|_| {})?;
+            run_prepared(p, opts, threads, &build_simulation, &stress_3d)
+        } else if scene.dim() == 3 {
             let p = super::solid::prepare_solid(scene, &|_| {})?;
             run_prepared(p, opts, threads, &build_simulation, &stress_3d)
         } else if slots_of(scene) == random::SLOTS_2D {
@@ -299,12 +302,17 @@ fn run_prepared<const K: usize, const D: usize>(
     );
     let outcome = Outcome {
         summary,
-        cells: p.model.random.as_ref().map(|r| {
-            r.cells
-                .iter()
-                .map(|c| c.iter().map(|v| [v.x, v.y]).collect())
-                .collect()
-        }),
+        cells: p
+            .model
+            .random
+            .as_ref()
+            .filter(|r| !r.cells.is_empty())
+            .map(|r| {
+                r.cells
+                    .iter()
+                    .map(|c| c.iter().map(|v| [v.x, v.y]).collect())
+                    .collect()
+            }),
         moduli_residual: p.model.random.as_ref().map(|r| r.moduli.residual.clone()),
         records,
         increments,

@@ -86,8 +86,10 @@ pub fn estimated_particles(scene: &Scene) -> f64 {
 
 /// Estimated bytes a run allocates (2D or 3D; with `[concrete]`, the damage kernel's too).
 pub fn estimated_memory(scene: &Scene) -> f64 {
-    let dim = scene.discretisation.dim();
-    let slots = if dim == 3 {
+    let dim = scene.dim();
+    let slots = if dim == 3 && scene.discretisation.is_random() {
+        crate::discretise::random3::SLOTS_3D
+    } else if dim == 3 {
         crate::discretise::fcc::SLOTS
     } else {
         slots_of(scene)
@@ -229,7 +231,7 @@ fn assemble<const K: usize>(
 ) -> Result<Model<K>, RunError> {
     let d = &scene.discretisation;
     let m = &scene.material;
-    if d.dim() == 3 {
+    if scene.dim() == 3 {
         return Err(RunError::Setup(format!(
             "discretisation.lattice = \"fcc\" (body.shape = \"{}\") is a 3D scene: its model is assembled by run::solid::prepare_model_solid / prepare_solid, not by the 2D assembly",
             scene.body.name()
@@ -549,17 +551,55 @@ pub fn fit_moduli<const K: usize>(
     a: &mut [f64],
     b: &mut [f64],
 ) -> ModuliFit {
+    fit_moduli_with(
+        particles,
+        |bonds, volume, ell| crate::model::dimension::fit_weighted_2d(bonds, volume, ell, d),
+        a,
+        b,
+    )
+}
+
+/// [`fit_moduli`] in 3D (random particles in a solid): against the isotropic 6×6 `d`
+/// (3.20), with the weighted dilatation.
+pub fn fit_moduli_3d<const K: usize>(
+    particles: &Particles<3, K>,
+    d: &nalgebra::Matrix6<f64>,
+    a: &mut [f64],
+    b: &mut [f64],
+) -> ModuliFit {
+    fit_moduli_with(
+        particles,
+        |bonds, volume, ell| crate::model::micro_modulus::fit_weighted_3d(bonds, volume, ell, d),
+        a,
+        b,
+    )
+}
+
+/// Each particle's (a_i, b_i) from `fit` of its reference bonds, volume and length scale, and
+/// the residual statistics ([`fit_moduli`], [`fit_moduli_3d`]).
+fn fit_moduli_with<const D: usize, const K: usize>(
+    particles: &Particles<D, K>,
+    fit: impl Fn(&[(nalgebra::SVector<f64, D>, f64)], f64, f64) -> Option<crate::model::dimension::Fit>
+        + Sync,
+    a: &mut [f64],
+    b: &mut [f64],
+) -> ModuliFit {
+    use rayon::prelude::*;
     let n = particles.len();
+    let fits: Vec<Option<crate::model::dimension::Fit>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            fit(
+                &particles.reference_bonds(i),
+                particles.volume[i],
+                particles.length[i],
+            )
+        })
+        .collect();
     let mut residual = vec![f64::NAN; n];
     let mut unfitted = 0;
-    for i in 0..n {
-        let fit = crate::model::dimension::fit_weighted_2d(
-            &particles.reference_bonds(i),
-            particles.volume[i],
-            particles.length[i],
-            d,
-        );
-        match fit {
+    for (i, f) in fits.into_iter().enumerate() {
+        match f {
             Some(f) => {
                 a[i] = f.moduli.a;
                 b[i] = f.moduli.b;

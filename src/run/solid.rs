@@ -6,13 +6,14 @@
 //! plane).
 
 use super::prepare::{
-    check_size, dynamics, estimated_particles, supports, Model, Prepared, SurfaceCorrection,
+    check_size, dynamics, estimated_particles, supports, Model, Prepared, RandomBody,
+    SurfaceCorrection,
 };
 use super::RunError;
 use crate::discretise::fcc::{cell_volume, FccLattice, SECOND, SLOTS, STEPS};
 use crate::discretise::groups;
 use crate::discretise::NONE;
-use crate::discretise::{voronoi3, Particles};
+use crate::discretise::{random3, voronoi3, Particles};
 use crate::geometry::Shape3;
 use crate::model::dimension::{Dim, Dimension};
 use crate::model::micro_modulus::{fit_fcc_weighted, fit_weighted_3d, FccBond, FccModuli};
@@ -112,29 +113,58 @@ pub fn prepare_model_solid(
     scene: &Scene,
     stage: &dyn Fn(&str),
 ) -> Result<Model<SLOTS, 3>, RunError> {
-    let refuse = |key: &str, value: String, allowed: &str| {
-        RunError::Scene(crate::scene::SceneError::Invalid {
-            key: key.into(),
-            value,
-            allowed: allowed.into(),
-        })
-    };
-    if !scene.random_field.is_empty() {
-        return Err(refuse(
-            "random_field",
-            format!("{} random fields", scene.random_field.len()),
-            "absent in 3D for now (the fields are sampled in the plane)",
-        ));
-    }
+    refuse_fields(scene)?;
     stage(&format!(
         "filling the body with about {:.3e} FCC particles",
         estimated_particles(scene)
     ));
     let (particles, body) = fcc_body(scene)?;
+    let m = &scene.material;
+    let n = particles.len();
+    let bulk = bulk_moduli(m.youngs_modulus(), m.nu, scene.discretisation.spacing);
+    let moduli = body.moduli;
+    let surface = SurfaceCorrection {
+        method: body.method,
+        enabled: body.method != "lattice",
+        boundary_particles: n - moduli.bulk,
+        corrected: moduli.fitted + moduli.fitted_without_c,
+        kept_bulk: moduli.unfitted,
+        max_residual: moduli.max_residual,
+        body_volume: body.body_volume,
+        particle_volume: body.particle_volume,
+    };
+    let bulk = crate::model::dimension::MicroModuli {
+        a: bulk.a,
+        b: bulk.b,
+    };
+    assemble(scene, particles, bulk, surface, None)
+}
+
+/// Random fields are sampled in the plane: a 3D scene refuses them.
+fn refuse_fields(scene: &Scene) -> Result<(), RunError> {
+    if scene.random_field.is_empty() {
+        return Ok(());
+    }
+    Err(RunError::Scene(crate::scene::SceneError::Invalid {
+        key: "random_field".into(),
+        value: format!("{} random fields", scene.random_field.len()),
+        allowed: "absent in 3D for now (the fields are sampled in the plane)".into(),
+    }))
+}
+
+/// The groups, supports and mechanics of a 3D body with its micro-moduli set.
+fn assemble<const K: usize>(
+    scene: &Scene,
+    particles: Particles<3, K>,
+    bulk: crate::model::dimension::MicroModuli,
+    surface: SurfaceCorrection,
+    random: Option<RandomBody>,
+) -> Result<Model<K, 3>, RunError> {
     let solid = scene.solid().ok_or_else(|| {
-        RunError::Setup(
-            "discretisation.lattice = \"fcc\" needs a solid body (box, cylinder or prism)".into(),
-        )
+        RunError::Setup(format!(
+            "discretisation.lattice = \"{}\" in 3D needs a solid body (box, cylinder or prism)",
+            scene.discretisation.lattice
+        ))
     })?;
     let section = scene.section_along_z();
     let (lo, hi) = solid.bounding_box();
@@ -148,21 +178,10 @@ pub fn prepare_model_solid(
         &|sel| groups::select_3d(sel, &particles, &solid, section.as_ref()),
         &extent,
     )?;
-    let m = &scene.material;
-    let n = particles.len();
-    let bulk = bulk_moduli(m.youngs_modulus(), m.nu, scene.discretisation.spacing);
-    let mech = crate::solver::mechanics::Mechanics::new(&particles, &vec![m.rho; n]);
-    let moduli = body.moduli;
-    let surface = SurfaceCorrection {
-        method: body.method,
-        enabled: body.method != "lattice",
-        boundary_particles: n - moduli.bulk,
-        corrected: moduli.fitted + moduli.fitted_without_c,
-        kept_bulk: moduli.unfitted,
-        max_residual: moduli.max_residual,
-        body_volume: body.body_volume,
-        particle_volume: body.particle_volume,
-    };
+    let mech = crate::solver::mechanics::Mechanics::new(
+        &particles,
+        &vec![scene.material.rho; particles.len()],
+    );
     Ok(Model {
         scene: scene.clone(),
         particles,
@@ -170,14 +189,98 @@ pub fn prepare_model_solid(
         prescribed,
         constrained,
         mech,
-        bulk: crate::model::dimension::MicroModuli {
-            a: bulk.a,
-            b: bulk.b,
-        },
+        bulk,
         surface,
         fields: Vec::new(),
-        random: None,
+        random,
     })
+}
+
+/// The assembled elastic model of a 3D scene of random particles (SPPM, `lattice =
+/// "random"` in a solid; [`random3::SLOTS_3D`] slots): the particles, their clipped Voronoi
+/// volumes and bonds (`discretise::random3`), each particle's least-squares (a_i, b_i)
+/// against the isotropic D (3.20) with the weighted dilatation, groups and supports.
+/// Particles no fit can serve (too few or coplanar bonds) take the median fitted moduli per
+/// unit volume times their own volume, and are counted (`surface_correction.kept_bulk`).
+pub fn prepare_model_random_solid(
+    scene: &Scene,
+    stage: &dyn Fn(&str),
+) -> Result<Model<{ random3::SLOTS_3D }, 3>, RunError> {
+    refuse_fields(scene)?;
+    check_size(scene)?;
+    let solid = scene.solid().ok_or_else(|| {
+        RunError::Setup("discretisation.lattice = \"random\" in 3D needs a solid body".into())
+    })?;
+    let recipe = random3::RandomSolid::of_scene(scene);
+    stage(&format!(
+        "placing {} random particles, their clipped Voronoi cells and bonds",
+        random3::target_count(&solid, recipe.spacing)
+    ));
+    let (mut particles, generation) = random3::fill::<{ random3::SLOTS_3D }>(&solid, &recipe)
+        .map_err(|e| {
+            RunError::Setup(format!(
+                "discretisation.spacing = {} (lattice = \"random\", min_distance = {}): {e}",
+                recipe.spacing, recipe.min_distance
+            ))
+        })?;
+    stage("micro-moduli of every particle (least squares)");
+    let m = &scene.material;
+    let d = <Dim<3> as Dimension<3>>::elasticity(m.youngs_modulus(), m.nu, Plane::Stress);
+    let n = particles.len();
+    let (mut a, mut b) = (vec![f64::NAN; n], vec![f64::NAN; n]);
+    let moduli = crate::run::prepare::fit_moduli_3d(&particles, &d, &mut a, &mut b);
+    let per_volume = |v: &[f64]| {
+        let mut q: Vec<f64> = (0..n)
+            .filter(|&i| v[i].is_finite())
+            .map(|i| v[i] / particles.volume[i])
+            .collect();
+        q.sort_by(f64::total_cmp);
+        q.get(q.len() / 2).copied()
+    };
+    let (Some(a_bulk), Some(b_bulk)) = (per_volume(&a), per_volume(&b)) else {
+        return Err(RunError::Setup(format!(
+            "discretisation.spacing = {}: no random particle's bonds carry a fit of the micro-moduli (too few or coplanar bonds); use a smaller spacing",
+            recipe.spacing
+        )));
+    };
+    for i in 0..n {
+        if !a[i].is_finite() {
+            a[i] = a_bulk * particles.volume[i];
+            b[i] = b_bulk * particles.volume[i];
+        }
+    }
+    particles.a = a;
+    particles.b = b;
+    let surface = SurfaceCorrection {
+        method: Surface::VoronoiFit.name(),
+        enabled: true,
+        boundary_particles: generation.outline_particles,
+        corrected: n - moduli.unfitted,
+        kept_bulk: moduli.unfitted,
+        max_residual: moduli.residual_max,
+        body_volume: solid.volume(),
+        particle_volume: particles.volume.iter().sum(),
+    };
+    // the bulk constants reported: the median particle's, at the FCC cell volume of L0
+    let cell = cell_volume(recipe.spacing);
+    let bulk = crate::model::dimension::MicroModuli {
+        a: a_bulk * cell,
+        b: b_bulk * cell,
+    };
+    let random = RandomBody {
+        cells: Vec::new(),
+        generation,
+        moduli,
+    };
+    assemble(scene, particles, bulk, surface, Some(random))
+}
+
+/// Discretise and assemble a 3D scene of random particles, compute T1 and the time step.
+pub fn prepare_random_solid(
+    scene: &Scene,
+    stage: &dyn Fn(&str),
+) -> Result<Prepared<{ random3::SLOTS_3D }, 3>, RunError> {
+    dynamics(prepare_model_random_solid(scene, stage)?, stage)
 }
 
 /// Discretise and assemble a 3D scene, compute T1 and the time step.

@@ -397,15 +397,6 @@ impl DiscretisationSpec {
         self.lattice == "random"
     }
 
-    /// The spatial dimension: 3 for the FCC lattice, 2 otherwise.
-    pub fn dim(&self) -> usize {
-        if self.lattice == "fcc" {
-            3
-        } else {
-            2
-        }
-    }
-
     /// The offset in the plane (2D; validated to have two components).
     pub fn offset2(&self) -> [f64; 2] {
         [
@@ -1000,6 +991,16 @@ fn default_field() -> Field {
 }
 
 impl Scene {
+    /// The spatial dimension: 3 for the FCC lattice and for random particles in a solid
+    /// (box, cylinder, prism), 2 otherwise.
+    pub fn dim(&self) -> usize {
+        match self.discretisation.lattice.as_str() {
+            "fcc" => 3,
+            "random" if self.body.is_solid() => 3,
+            _ => 2,
+        }
+    }
+
     /// Parse TOML text, apply `key=value` overrides, and validate.
     pub fn from_toml_str(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
         let mut value: toml::Table = text

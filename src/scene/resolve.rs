@@ -193,7 +193,7 @@ impl Scene {
         // The crack opening of a particle at initiation, 2·L0·f't/E (4.13): the softening law
         // needs room beyond it.
         let l0 = self.discretisation.spacing;
-        let (default, source) = if self.discretisation.dim() == 3 {
+        let (default, source) = if self.dim() == 3 {
             (
                 FCC_CRACK_BAND,
                 "the FCC lattice's default (benchmarks/RESULTS.md, \"Concrete in 3D\")",
