@@ -57,11 +57,17 @@ pub struct FccLattice {
     pub offset: Vector3<f64>,
 }
 
+/// The rotation of angles [α, β, γ] (degrees) about z, y and x: the FCC lattice's frame, and
+/// the frame random 3D particles are drawn in (`random3`).
+pub fn rotation_of(deg: [f64; 3]) -> Matrix3<f64> {
+    let [a, b, g] = deg.map(f64::to_radians);
+    *Rotation3::from_euler_angles(g, b, a).matrix()
+}
+
 impl FccLattice {
     /// The rotation R of the lattice frame.
     pub fn rotation(&self) -> Matrix3<f64> {
-        let [a, b, g] = self.rotation_deg.map(f64::to_radians);
-        *Rotation3::from_euler_angles(g, b, a).matrix()
+        rotation_of(self.rotation_deg)
     }
 
     /// Half the cubic constant: the lattice-frame unit L0/√2 (m).

@@ -26,7 +26,7 @@
 use super::random::{Generation, DEFAULT_MIN_DISTANCE};
 use super::{voronoi3, Particles, NONE};
 use crate::geometry::{Piece, Shape3};
-use nalgebra::{Matrix3, Rotation3, Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 use rand::rngs::ChaCha20Rng;
 use rand::{Rng, SeedableRng};
 
@@ -65,8 +65,7 @@ impl RandomSolid {
     }
 
     fn rotation(&self) -> Matrix3<f64> {
-        let [a, b, g] = self.rotation_deg.map(f64::to_radians);
-        *Rotation3::from_euler_angles(g, b, a).matrix()
+        super::fcc::rotation_of(self.rotation_deg)
     }
 }
 

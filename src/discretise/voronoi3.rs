@@ -156,13 +156,7 @@ pub fn clipped_volumes(x: &[P], shape: &Shape3, spacing: f64) -> Vec<f64> {
     match shape.sweep() {
         Some(sweep) => {
             let q: Vec<P> = x.iter().map(|x| sweep.local(x)).collect();
-            let (section, length) = (&sweep.section, sweep.length);
-            let (lo, hi) = section.bounding_box();
-            let pad = 1e-3 * section.size().max(length);
-            let bounds = ConvexPolyhedron::cuboid(
-                P::new(lo.x - pad, lo.y - pad, 0.0),
-                P::new(hi.x + pad, hi.y + pad, length),
-            );
+            let bounds = sweep_bounds(&sweep);
             let tree = tree_of(&q);
             let tol = 1e-12 * spacing.powi(3);
             (0..q.len())
@@ -170,31 +164,18 @@ pub fn clipped_volumes(x: &[P], shape: &Shape3, spacing: f64) -> Vec<f64> {
                 .map(|i| {
                     let cell = nearest_first_cell(&q, i, &tree, &bounds, 2.0 * spacing);
                     let xy = Vector2::new(q[i].x, q[i].y);
-                    let depth = if section.contains(&xy, 0.0) {
-                        section.boundary_distance(&xy)
-                    } else {
-                        0.0
-                    };
-                    // a cell whose projection lies in the section keeps its clipped volume
-                    let radius_xy = cell
-                        .faces
-                        .iter()
-                        .flatten()
-                        .map(|v| (Vector2::new(v.x, v.y) - xy).norm())
-                        .fold(0.0, f64::max);
-                    if depth > radius_xy * (1.0 + 1e-9) {
-                        cell.volume()
-                    } else {
-                        volume_in_section(&cell, section, tol)
-                    }
+                    volume_within(
+                        &cell,
+                        xy,
+                        depth_in(&sweep.section, &xy),
+                        &sweep.section,
+                        tol,
+                    )
                 })
                 .collect()
         }
         None => {
-            let planes = shape.planes().expect("a convex polyhedral body");
-            let (lo, hi) = shape.bounding_box();
-            let pad = P::repeat(1e-3 * shape.size());
-            let body = ConvexPolyhedron::from_planes(&planes, lo - pad, hi + pad);
+            let body = body_polyhedron(shape);
             let tree = tree_of(x);
             (0..x.len())
                 .into_par_iter()
@@ -259,6 +240,58 @@ fn nearest_first_cell(
     }
 }
 
+/// The convex polyhedron of a box-shaped body, padded by 1e-3 of its size (the bounds its
+/// cells are clipped from).
+fn body_polyhedron(shape: &Shape3) -> ConvexPolyhedron {
+    let planes = shape.planes().expect("a convex polyhedral body");
+    let (lo, hi) = shape.bounding_box();
+    let pad = P::repeat(1e-3 * shape.size());
+    ConvexPolyhedron::from_planes(&planes, lo - pad, hi + pad)
+}
+
+/// The bounds of a swept body's cells in its local coordinates: the section's box, padded,
+/// through w ∈ [0, length].
+fn sweep_bounds(sweep: &Sweep) -> ConvexPolyhedron {
+    let (lo, hi) = sweep.section.bounding_box();
+    let pad = 1e-3 * sweep.section.size().max(sweep.length);
+    ConvexPolyhedron::cuboid(
+        P::new(lo.x - pad, lo.y - pad, 0.0),
+        P::new(hi.x + pad, hi.y + pad, sweep.length),
+    )
+}
+
+/// The volume of `cell` (local coordinates of a swept body) within the section: the cell's
+/// own where its projection lies `depth` inside the section (the particle at `xy`), else
+/// [`volume_in_section`] to `tol`.
+fn volume_within(
+    cell: &ConvexPolyhedron,
+    xy: Vector2<f64>,
+    depth: f64,
+    section: &Shape2,
+    tol: f64,
+) -> f64 {
+    let radius_xy = cell
+        .faces
+        .iter()
+        .flatten()
+        .map(|v| (Vector2::new(v.x, v.y) - xy).norm())
+        .fold(0.0, f64::max);
+    if depth > radius_xy * (1.0 + 1e-9) {
+        cell.volume()
+    } else {
+        volume_in_section(cell, section, tol)
+    }
+}
+
+/// How deep `xy` lies inside the section (0 outside it).
+fn depth_in(section: &Shape2, xy: &Vector2<f64>) -> f64 {
+    if section.contains(xy, 0.0) {
+        section.boundary_distance(xy)
+    } else {
+        0.0
+    }
+}
+
 /// An R-tree of points, each with its index.
 fn tree_of(x: &[P]) -> RTree<GeomWithData<[f64; 3], usize>> {
     RTree::bulk_load(
@@ -309,9 +342,7 @@ fn clipped_cell(
 /// The cells of a box-shaped body: the body's convex polyhedron clipped by the bisectors.
 fn polyhedral_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
     let planes = shape.planes().expect("a convex polyhedral body");
-    let (lo, hi) = shape.bounding_box();
-    let pad = P::repeat(1e-3 * shape.size());
-    let body = ConvexPolyhedron::from_planes(&planes, lo - pad, hi + pad);
+    let body = body_polyhedron(shape);
     let l0 = p.spacing;
     let full = cell_volume(l0);
     let inside = |x: &P| {
@@ -345,12 +376,7 @@ fn sectioned_volumes(p: &Particles<3, SLOTS>, sweep: &Sweep) -> Vec<f64> {
     let l0 = p.spacing;
     let full = cell_volume(l0);
     let rc = l0 / 2f64.sqrt() * (1.0 + 1e-9);
-    let (lo, hi) = section.bounding_box();
-    let pad = 1e-3 * section.size().max(length);
-    let bounds = ConvexPolyhedron::cuboid(
-        P::new(lo.x - pad, lo.y - pad, 0.0),
-        P::new(hi.x + pad, hi.y + pad, length),
-    );
+    let bounds = sweep_bounds(sweep);
     let tree = tree_of(&q);
     let tol = 1e-12 * full;
     (0..p.len())
@@ -359,27 +385,12 @@ fn sectioned_volumes(p: &Particles<3, SLOTS>, sweep: &Sweep) -> Vec<f64> {
             let x = q[i];
             let xy = Vector2::new(x.x, x.y);
             let nearest_all = p.neighbours[i][..SECOND].iter().all(|&j| j != NONE);
-            let in_section = section.contains(&xy, 0.0);
-            let depth = if in_section {
-                section.boundary_distance(&xy)
-            } else {
-                0.0
-            };
+            let depth = depth_in(section, &xy);
             if nearest_all && x.z > rc && x.z < length - rc && depth > rc {
                 return full;
             }
             let cell = clipped_cell(&q, i, &tree, &bounds, 2.5 * l0);
-            // a cell whose projection lies in the section keeps its clipped volume
-            let radius_xy = cell
-                .faces
-                .iter()
-                .flatten()
-                .map(|v| (Vector2::new(v.x, v.y) - xy).norm())
-                .fold(0.0, f64::max);
-            if depth > radius_xy * (1.0 + 1e-9) {
-                return cell.volume();
-            }
-            volume_in_section(&cell, section, tol)
+            volume_within(&cell, xy, depth, section, tol)
         })
         .collect()
 }
