@@ -280,7 +280,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// `sppm check` of a prepared scene (2D, or 3D with an FCC body), its simulation built by
+/// `sppm check` of a prepared scene (2D, or 3D: FCC or random particles), its simulation built by
 /// `simulate`: the body, groups, T1, time step, memory and the run time from a few timed
 /// steps.
 fn check<const K: usize, const D: usize>(
@@ -303,7 +303,12 @@ fn check<const K: usize, const D: usize>(
     say!("scene            {}", sc.name());
     if D == 3 {
         say!(
-            "lattice          fcc (3D), rotation {:?}°",
+            "lattice          {} (3D), rotation {:?}°",
+            if sc.discretisation.is_random() {
+                "random particles"
+            } else {
+                "fcc"
+            },
             sc.discretisation.rotation_deg.angles()
         );
     }

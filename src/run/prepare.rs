@@ -222,6 +222,16 @@ pub fn prepare_model_with<const K: usize>(
     assemble(scene, stage, true)
 }
 
+/// The error of a ν outside the range random particles' elastic calibration covers
+/// (`allowed` names the range).
+pub(crate) fn nu_outside_calibration(nu: f64, allowed: String) -> RunError {
+    RunError::Scene(crate::scene::SceneError::Invalid {
+        key: "material.nu".into(),
+        value: nu.to_string(),
+        allowed,
+    })
+}
+
 /// [`prepare_model_with`]; `calibrate`: random particles are fitted to the calibrated target
 /// (E*, ν*) of `model::sppm_calibration` rather than to the scene's (E, ν).
 fn assemble<const K: usize>(
@@ -322,13 +332,7 @@ fn assemble<const K: usize>(
             let md = generation.min_distance;
             let (e, nu) =
                 crate::model::sppm_calibration::fit_target(m.youngs_modulus(), m.nu, m.plane(), md)
-                    .map_err(|allowed| {
-                        RunError::Scene(crate::scene::SceneError::Invalid {
-                            key: "material.nu".into(),
-                            value: m.nu.to_string(),
-                            allowed,
-                        })
-                    })?;
+                    .map_err(|allowed| nu_outside_calibration(m.nu, allowed))?;
             micro_modulus::elasticity_matrix(e, nu, m.plane())
         }
         _ => dmat,

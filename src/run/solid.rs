@@ -199,9 +199,11 @@ fn assemble<const K: usize>(
 /// The assembled elastic model of a 3D scene of random particles (SPPM, `lattice =
 /// "random"` in a solid; [`random3::SLOTS_3D`] slots): the particles, their clipped Voronoi
 /// volumes and bonds (`discretise::random3`), each particle's least-squares (a_i, b_i)
-/// against the isotropic D (3.20) with the weighted dilatation, groups and supports.
-/// Particles no fit can serve (too few or coplanar bonds) take the median fitted moduli per
-/// unit volume times their own volume, and are counted (`surface_correction.kept_bulk`).
+/// against the isotropic D (3.20) of the calibrated pair (E*, ν*) that makes the body show the
+/// scene's (E, ν) (`model::sppm_calibration::fit_target_3d`), with the weighted dilatation;
+/// groups and supports. Particles no fit can serve (too few or coplanar bonds) take the
+/// median fitted moduli per unit volume times their own volume, and are counted
+/// (`surface_correction.kept_bulk`).
 pub fn prepare_model_random_solid(
     scene: &Scene,
     stage: &dyn Fn(&str),
@@ -225,7 +227,13 @@ pub fn prepare_model_random_solid(
         })?;
     stage("micro-moduli of every particle (least squares)");
     let m = &scene.material;
-    let d = <Dim<3> as Dimension<3>>::elasticity(m.youngs_modulus(), m.nu, Plane::Stress);
+    let (e_fit, nu_fit) = crate::model::sppm_calibration::fit_target_3d(
+        m.youngs_modulus(),
+        m.nu,
+        recipe.min_distance,
+    )
+    .map_err(|allowed| crate::run::prepare::nu_outside_calibration(m.nu, allowed))?;
+    let d = <Dim<3> as Dimension<3>>::elasticity(e_fit, nu_fit, Plane::Stress);
     let n = particles.len();
     let (mut a, mut b) = (vec![f64::NAN; n], vec![f64::NAN; n]);
     let moduli = crate::run::prepare::fit_moduli_3d(&particles, &d, &mut a, &mut b);

@@ -535,7 +535,9 @@ pub struct ConcreteSpec {
     /// with 2, a block in uniaxial tension dissipates 1.32 and 1.47 × G_f·A at L0 = 10 and
     /// 5 mm; with 2.8, 0.975 and 1.029 × G_f·A (benchmarks/RESULTS.md, "Concrete in 2D").
     /// Random particles 3.2 (docs/sppm.md, "Crack band"); the FCC lattice 3.3
-    /// (benchmarks/RESULTS.md, "Concrete in 3D"). Always set after [`Scene::resolve`].
+    /// (benchmarks/RESULTS.md, "Concrete in 3D"); random particles in 3D
+    /// (`scene::resolve::RANDOM_3D_CRACK_BAND`; benchmarks/RESULTS.md, "Random particles in 3D").
+    /// Always set after [`Scene::resolve`].
     #[serde(default)]
     pub crack_band: Option<f64>,
     #[serde(default = "default_initiation")]

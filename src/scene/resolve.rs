@@ -18,6 +18,11 @@ pub const RANDOM_CRACK_BAND: f64 = 3.2;
 /// "Concrete in 3D": a tension prism's dissipated energy against G_f·A at two spacings).
 pub const FCC_CRACK_BAND: f64 = 3.3;
 
+/// The crack band of random particles in 3D in units of each particle's mean bond length
+/// (measured: benchmarks/RESULTS.md, "Random particles in 3D": a tension prism's dissipated
+/// energy against G_f·A).
+pub const RANDOM_3D_CRACK_BAND: f64 = 3.0;
+
 fn positive_opt(key: &str, v: Option<f64>) -> Result<(), SceneError> {
     match v {
         Some(x) if !(x.is_finite() && x > 0.0) => {
@@ -193,7 +198,12 @@ impl Scene {
         // The crack opening of a particle at initiation, 2·L0·f't/E (4.13): the softening law
         // needs room beyond it.
         let l0 = self.discretisation.spacing;
-        let (default, source) = if self.dim() == 3 {
+        let (default, source) = if self.dim() == 3 && self.discretisation.is_random() {
+            (
+                RANDOM_3D_CRACK_BAND,
+                "random 3D particles' default (benchmarks/RESULTS.md, \"Random particles in 3D\")",
+            )
+        } else if self.dim() == 3 {
             (
                 FCC_CRACK_BAND,
                 "the FCC lattice's default (benchmarks/RESULTS.md, \"Concrete in 3D\")",

@@ -93,13 +93,6 @@ impl Scene {
                 "\"hexagonal\" (2D SPLM), \"random\" (SPPM: random Voronoi-weighted particles, 2D or in a solid body) or \"fcc\" (3D SPLM)",
             ));
         }
-        if d.is_random() && self.dim() == 3 && self.concrete.is_some() {
-            return Err(invalid(
-                "concrete",
-                "present",
-                "absent for lattice = \"random\" in a solid body for now: the damage of random 3D particles needs its crack band calibrated on a tension prism (issue 17, item 4), which has not been done; run the elastic model, or [concrete] on lattice = \"fcc\"",
-            ));
-        }
         if d.is_random() {
             if let Some(f) = d.min_distance {
                 if !(f.is_finite() && (0.5..=0.75).contains(&f)) {

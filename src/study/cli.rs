@@ -19,6 +19,10 @@ pub enum StudyCommand {
         /// Lattice rotations in degrees, comma-separated.
         #[arg(long, default_value = "0,15,30,45")]
         angles: String,
+        /// The axis the angles turn the lattice or particle set about: z (2D, and 3D's
+        /// default), x or y (3D: turns a prism's loading axis along z against the particles).
+        #[arg(long, default_value_t = 'z')]
+        axis: char,
         /// Random lattice offsets per angle, besides the scene's own offset (random particles:
         /// further particle sets per angle, besides the scene's own seed).
         #[arg(long, default_value_t = 0)]
@@ -116,6 +120,7 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
         StudyCommand::Objectivity {
             scene,
             angles,
+            axis,
             offsets,
             seed,
             crack_damage,
@@ -131,6 +136,7 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 crack_damage,
                 scene,
                 angles_deg: parse_list("--angles", &angles)?,
+                axis,
                 offsets,
                 seed,
                 overrides: set,

@@ -263,10 +263,11 @@ pub fn random_block_modulus(
     block_moduli(&p, width, height, 1.5 * recipe.spacing)
 }
 
-/// (E/E0, ν/ν0) of a 3D block W × W × H (z along H) of particles with their moduli: the rows
-/// within `band` of z = 0 held in z, those within `band` of z = H pulled to a strain of 1e-4
-/// (sides free), the static solution read by [`prism_moduli`].
-fn block_moduli<const K: usize>(
+/// (E/E0, ν/ν0) of a 3D block W × W × H (z along H, lower corner at the origin) of particles
+/// with their moduli, against this module's [`E`] and [`NU`]: the rows within `band` of z = 0
+/// held in z, those within `band` of z = H pulled to a strain of 1e-4 (sides free), the
+/// static solution read by [`prism_moduli`].
+pub fn block_moduli<const K: usize>(
     p: &crate::discretise::Particles<3, K>,
     width: f64,
     height: f64,

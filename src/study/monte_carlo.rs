@@ -5,7 +5,8 @@
 //!
 //! - **Sizes.** `--sizes` takes dog-bone letters A–F (D = 0.05, 0.1, 0.2, 0.4, 0.8, 1.6 m) or
 //!   sizes D in m. The size variant of size D from a scene of size D0 and spacing s0 has
-//!   `body.size = D`, `discretisation.spacing = s0·min(1, D/D0)` (the same particles per
+//!   `body.size = D` (a 3D prism of the dog-bone section: `body.section.size = D`, its
+//!   thickness kept), `discretisation.spacing = s0·min(1, D/D0)` (the same particles per
 //!   width below the scene's size; the scene's spacing, which resolves the material's
 //!   correlation length, above it), every loaded group's displacement scaled by √(D/D0), and,
 //!   with the relaxation solver, `solver.max_iterations()` scaled by max(1, D/D0).
@@ -20,6 +21,9 @@
 //!     large sizes came out high: dog-bone F, one realisation, 181.6 / 167.9 / 165.0 kN at 500 /
 //!     2000 / 4000 iterations (E: 92.5 / 90.65 / 90.2 kN at 500 / 1000 / 2000; D: 50.52 / 50.36 kN
 //!     at 500 / 2000).
+//! - **Random particles** (2D, and 3D solids) draw a new particle set per realisation from its
+//!   seed; 3D bodies other than the dog-bone prism read σN over their mean section normal to
+//!   the loaded component ([`nominal_strength`]).
 //! - **Seeds.** Realisation r (0-based) of size D has the seed
 //!   [`realisation_seed`]`(S, D, r)`, a SplitMix64 hash of the study seed S, D in µm (an
 //!   integer) and r: independent of the shard, the job count and the order of the runs. It is
@@ -290,17 +294,43 @@ pub struct MonteCarloArgs {
 }
 
 /// The nominal strength σN = P_max/(b·D·t) of a run of `scene`: b = 0.6 and D the size of a
-/// dog-bone (σN is then the mean stress over the neck), else b = 1 and D the body's width.
+/// dog-bone (σN is then the mean stress over the neck; in 3D t is the prism's thickness),
+/// else b = 1 and D the body's width. Other 3D bodies: σN = P_max/A with A = V/ℓ, the body's
+/// mean section normal to the loaded component (ℓ its extent along it; a box's or a
+/// prism's section when pulled along its length).
 pub fn nominal_strength(scene: &Scene, peak_force_n: f64) -> f64 {
     let (d, b) = nominal_size(scene);
-    peak_force_n.abs() / (b * d * scene.material.thickness())
+    match (&scene.body, scene.solid()) {
+        (BodySpec::Prism { thickness, .. }, _) if dogbone_size(&scene.body).is_some() => {
+            peak_force_n.abs() / (b * d * thickness)
+        }
+        (_, Some(solid)) => {
+            let k = scene
+                .groups
+                .iter()
+                .find_map(|g| g.load.as_ref())
+                .map_or(2, |l| l.component.index());
+            let (lo, hi) = solid.bounding_box();
+            peak_force_n.abs() * (hi[k] - lo[k]) / solid.volume()
+        }
+        _ => peak_force_n.abs() / (b * d * scene.material.thickness()),
+    }
+}
+
+/// The size D of a dog-bone body: the 2D dog-bone or a prism of its section.
+fn dogbone_size(body: &BodySpec) -> Option<f64> {
+    match body {
+        BodySpec::Dogbone { size } => Some(*size),
+        BodySpec::Prism { section, .. } => dogbone_size(section),
+        _ => None,
+    }
 }
 
 /// (D, b) of [`nominal_strength`].
 fn nominal_size(scene: &Scene) -> (f64, f64) {
-    match scene.body {
-        BodySpec::Dogbone { size } => (size, 0.6),
-        _ => {
+    match dogbone_size(&scene.body) {
+        Some(size) => (size, 0.6),
+        None => {
             let (lo, hi) = scene.shape().bounding_box();
             (hi.x - lo.x, 1.0)
         }
@@ -323,12 +353,16 @@ fn toml_float(v: f64) -> String {
 
 /// The overrides that make the size variant of size `d` from `base` ([`SPACING_RULE`]).
 pub fn size_overrides(base: &Scene, d: f64) -> Vec<String> {
-    let BodySpec::Dogbone { size: d0 } = base.body else {
+    let Some(d0) = dogbone_size(&base.body) else {
         return vec![];
+    };
+    let key = match base.body {
+        BodySpec::Prism { .. } => "body.section.size",
+        _ => "body.size",
     };
     let ratio = d / d0;
     let mut o = vec![
-        format!("body.size={}", toml_float(d)),
+        format!("{key}={}", toml_float(d)),
         format!(
             "discretisation.spacing={}",
             toml_float(base.discretisation.spacing * ratio.min(1.0))
@@ -429,9 +463,9 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
     }
     let sizes = match &args.sizes {
         Some(s) => {
-            if !matches!(base.body, BodySpec::Dogbone { .. }) {
+            if dogbone_size(&base.body).is_none() {
                 bail!(
-                    "--sizes needs a dog-bone body ([body] shape = \"dogbone\"); the scene's body is `{}` (leave --sizes out to run the scene's own size)",
+                    "--sizes needs a dog-bone body ([body] shape = \"dogbone\", or a prism of a dog-bone section); the scene's body is `{}` (leave --sizes out to run the scene's own size)",
                     body_name(&base.body)
                 );
             }
@@ -1111,5 +1145,25 @@ mod tests {
         assert_eq!(o[3], "solver.max_iterations=2000", "500 × 1.6/0.4");
         let o = size_overrides(&relax, 0.05);
         assert_eq!(o[3], "solver.max_iterations=500", "not below the scene's");
+    }
+
+    /// 3D: a prism of the dog-bone section scales its section's size (thickness kept) and
+    /// its σN is the mean stress over the neck; a box pulled along z reads σN over its section.
+    #[test]
+    fn size_variant_and_strength_in_3d() {
+        let base = Scene::from_file(Path::new("lattices/dogbone_B_3d.toml"), &[]).unwrap();
+        let o = size_overrides(&base, 0.2);
+        assert_eq!(o[0], "body.section.size=0.2");
+        assert_eq!(
+            o[1], "discretisation.spacing=0.00625",
+            "the scene's above D0"
+        );
+        let s = Scene::from_file(Path::new("lattices/dogbone_B_3d.toml"), &o).unwrap();
+        assert_eq!(dogbone_size(&s.body), Some(0.2));
+        let sigma = nominal_strength(&s, 1.0e5);
+        assert!((sigma / (1.0e5 / (0.6 * 0.2 * 0.1)) - 1.0).abs() < 1e-12);
+        let prism = Scene::from_file(Path::new("lattices/tension_prism_3d.toml"), &[]).unwrap();
+        let sigma = nominal_strength(&prism, 1.0e5);
+        assert!((sigma / (1.0e5 / (0.15 * 0.15)) - 1.0).abs() < 1e-12);
     }
 }
