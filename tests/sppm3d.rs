@@ -185,6 +185,14 @@ fn the_random_box_runs_to_its_static_force() {
     let out = sppm::run::run(&sc, &sppm::run::RunOptions::default()).unwrap();
     assert_eq!(out.summary.status, "completed");
     assert_eq!(out.dim, 3);
+    // each particle's micro-moduli residual goes to the VTK file, and its statistics to the
+    // summary (a least-squares residual of two constants against D: in [0, 1))
+    let residual = out.moduli_residual.as_ref().unwrap();
+    assert_eq!(residual.len(), out.x0.len());
+    assert!(residual.iter().all(|r| (0.0..1.0).contains(r)));
+    let stats = out.summary.random_particles.as_ref().unwrap();
+    let max = residual.iter().cloned().fold(0.0, f64::max);
+    assert_eq!(stats.micro_moduli.residual_max, max);
     let f_run = out.records.last().unwrap().force_n;
     // the static solve of the same model
     let p = sppm::run::solid::prepare_random_solid(&sc, &|_| {}).unwrap();
@@ -315,6 +323,13 @@ fn random_3d_scenes_run_in_the_objectivity_and_monte_carlo_studies() {
         serde_json::from_str(&std::fs::read_to_string(obj.join("study_inputs.json")).unwrap())
             .unwrap();
     assert_eq!(inputs["axis"], "x");
+    // about x: rotation_deg = [α, β, γ] about z, y, x is [0, 0, 90]; the CSV shows the angle
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(obj.join("a90_o0").join("summary.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(summary["rotation_deg"], serde_json::json!([0.0, 0.0, 90.0]));
+    assert_eq!(row("90", "0")["rotation_deg"], "90");
     // a 2D scene has no x axis to turn about
     let o = common::sppm(&[
         "study",

@@ -333,6 +333,16 @@ impl Rotation {
         }
     }
 
+    /// The one angle of a rotation about one axis (the plane's, or one of three; 0 for no
+    /// turn); NaN for a turn about more than one axis. The rotation column of study CSVs.
+    pub fn single_angle(self) -> f64 {
+        match self {
+            Rotation::Angle(a) => a,
+            Rotation::Angles(v) if v.iter().filter(|a| **a != 0.0).count() <= 1 => v.iter().sum(),
+            Rotation::Angles(_) => f64::NAN,
+        }
+    }
+
     /// The angle in the plane of a 2D scene (validated to be one angle; NaN otherwise).
     pub fn angle(self) -> f64 {
         self.planar().unwrap_or(f64::NAN)

@@ -16,7 +16,8 @@
 //! ([`angle_effect`](super::angle_effect): a permutation test's p-value).
 //!
 //! In 3D (`--axis`) each angle turns the lattice or particle set about one axis
-//! (`discretisation.rotation_deg` = [a, 0, 0], [0, a, 0] or [0, 0, a]); about x or y it turns
+//! (`discretisation.rotation_deg` = [α, β, γ] about z, y and x: [a, 0, 0] about z, [0, a, 0]
+//! about y, [0, 0, a] about x); about x or y it turns
 //! the loading axis of a prism pulled along z against the particles. The crack-path columns
 //! are those of a plane's crack and stay empty in 3D; the crack counts are filled.
 
@@ -298,10 +299,11 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     let base = Scene::from_file(&args.scene, &args.overrides)?;
     let d = &base.discretisation;
     let three = base.dim() == 3;
+    // the index in rotation_deg = [α, β, γ], the angles about z, y and x
     let axis = match (args.axis, three) {
-        ('z', _) => 2,
-        ('x', true) => 0,
+        ('z', _) => 0,
         ('y', true) => 1,
+        ('x', true) => 2,
         (a, true) => bail!("--axis {a}: x, y or z"),
         (a, false) => {
             bail!("--axis {a}: z (or absent) for a 2D scene, whose lattice turns in its plane")

@@ -317,7 +317,7 @@ impl Study<'_> {
             label: v.label.clone(),
             tags: v.tags.clone(),
             spacing_m: d.spacing,
-            rotation_deg: d.rotation_deg.angle(),
+            rotation_deg: d.rotation_deg.single_angle(),
             offset_m: d.offset2(),
             particles: 0,
             peak_force_n: f64::NAN,
