@@ -57,6 +57,34 @@ pub struct Setup {
     pub moduli_s: f64,
 }
 
+/// Fit every random particle's micro-moduli with `fit` (2D or 3D), timed, and the set-up
+/// times of generation `g` with it; an error where a particle has no fit.
+fn fitted<const D: usize, const K: usize>(
+    p: &mut crate::discretise::Particles<D, K>,
+    g: &random::Generation,
+    fit: impl Fn(
+        &crate::discretise::Particles<D, K>,
+        &mut [f64],
+        &mut [f64],
+    ) -> crate::run::prepare::ModuliFit,
+) -> anyhow::Result<Setup> {
+    let t = Instant::now();
+    let (mut a, mut b) = (std::mem::take(&mut p.a), std::mem::take(&mut p.b));
+    let report = fit(p, &mut a, &mut b);
+    anyhow::ensure!(
+        report.unfitted == 0,
+        "{} particles have no moduli fit",
+        report.unfitted
+    );
+    (p.a, p.b) = (a, b);
+    Ok(Setup {
+        placing_s: g.seconds_placing,
+        voronoi_s: g.seconds_voronoi,
+        bonding_s: g.seconds_bonding,
+        moduli_s: t.elapsed().as_secs_f64(),
+    })
+}
+
 /// Bond layout of a benchmark.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Layout {
@@ -156,23 +184,10 @@ pub fn bench(
             };
             let (mut p, _, g) = random::fill::<{ random::SLOTS_2D }>(&shape, &recipe)
                 .map_err(|e| anyhow::anyhow!("random particles: {e}"))?;
-            let t = Instant::now();
             let d = micro_modulus::elasticity_matrix(30e9, 0.2, Plane::Stress);
-            let (mut a, mut b) = (std::mem::take(&mut p.a), std::mem::take(&mut p.b));
-            let fit = crate::run::prepare::fit_moduli(&p, &d, &mut a, &mut b);
-            anyhow::ensure!(
-                fit.unfitted == 0,
-                "{} particles have no moduli fit",
-                fit.unfitted
-            );
-            p.a = a;
-            p.b = b;
-            let setup = Setup {
-                placing_s: g.seconds_placing,
-                voronoi_s: g.seconds_voronoi,
-                bonding_s: g.seconds_bonding,
-                moduli_s: t.elapsed().as_secs_f64(),
-            };
+            let setup = fitted(&mut p, &g, |p, a, b| {
+                crate::run::prepare::fit_moduli(p, &d, a, b)
+            })?;
             time_steps(p, steps, threads, kernel, layout, Some(setup), simd)
         }
         other => anyhow::bail!("--lattice {other}: \"hexagonal\" or \"random\""),
@@ -425,28 +440,15 @@ pub fn bench_random3(
     let (p, setup) = pool.install(|| -> anyhow::Result<_> {
         let (mut p, g) = random3::fill::<SLOTS_3D>(&shape, &recipe)
             .map_err(|e| anyhow::anyhow!("random particles: {e}"))?;
-        let t = Instant::now();
         let d =
             <crate::model::dimension::Dim<3> as crate::model::dimension::Dimension<3>>::elasticity(
                 30e9,
                 0.2,
                 Plane::Stress,
             );
-        let (mut a, mut b) = (std::mem::take(&mut p.a), std::mem::take(&mut p.b));
-        let fit = crate::run::prepare::fit_moduli_3d(&p, &d, &mut a, &mut b);
-        anyhow::ensure!(
-            fit.unfitted == 0,
-            "{} particles have no moduli fit",
-            fit.unfitted
-        );
-        p.a = a;
-        p.b = b;
-        let setup = Setup {
-            placing_s: g.seconds_placing,
-            voronoi_s: g.seconds_voronoi,
-            bonding_s: g.seconds_bonding,
-            moduli_s: t.elapsed().as_secs_f64(),
-        };
+        let setup = fitted(&mut p, &g, |p, a, b| {
+            crate::run::prepare::fit_moduli_3d(p, &d, a, b)
+        })?;
         Ok((p, setup))
     })?;
     let n = p.len();
