@@ -189,7 +189,9 @@ pub fn clipped_volumes(x: &[P], shape: &Shape3, spacing: f64) -> Vec<f64> {
 /// of its neighbours nearest first until the next one lies farther than twice the cell's
 /// radius (it cannot cut the cell then). The cell starts as `bounds` cut to a cube of
 /// half-width `reach` about the particle, and is built again with twice the reach where it
-/// touches that cube (its radius reaches `reach`), so the cube never shapes a cell.
+/// touches that cube (its radius reaches `reach`), so the cube never shapes a cell. The
+/// cells of random particles and of FCC bodies alike (an FCC cell beside particles the fill
+/// dropped, `fcc::unbond_flat_particles`, reaches farther than L0 and is built again).
 fn nearest_first_cell(
     x: &[P],
     i: usize,
@@ -302,43 +304,6 @@ fn tree_of(x: &[P]) -> RTree<GeomWithData<[f64; 3], usize>> {
     )
 }
 
-/// The cell of particle i (positions x) within `bounds`: clipped by the bisector planes of
-/// the particles within `reach` (a point of the body lies within L0 of a particle, so
-/// particles within 2·L0 and a margin bound a cell), and again with a longer reach where the
-/// cell reaches farther than half of it from the particle (beside particles the fill dropped,
-/// `fcc::unbond_flat_particles`): a particle beyond twice the cell's radius cannot cut it.
-fn clipped_cell(
-    x: &[P],
-    i: usize,
-    tree: &RTree<GeomWithData<[f64; 3], usize>>,
-    bounds: &ConvexPolyhedron,
-    reach: f64,
-) -> ConvexPolyhedron {
-    let xi = x[i];
-    let mut reach = reach;
-    loop {
-        let mut cell = bounds.clone();
-        for o in tree.locate_within_distance([xi.x, xi.y, xi.z], reach * reach) {
-            if o.data == i {
-                continue;
-            }
-            let d = x[o.data] - xi;
-            let mid = xi + d * 0.5;
-            cell.clip(&d, d.dot(&mid));
-        }
-        let radius = cell
-            .faces
-            .iter()
-            .flatten()
-            .map(|v| (v - xi).norm())
-            .fold(0.0, f64::max);
-        if 2.0 * radius <= reach {
-            return cell;
-        }
-        reach = 2.0 * radius * (1.0 + 1e-9);
-    }
-}
-
 /// The cells of a box-shaped body: the body's convex polyhedron clipped by the bisectors.
 fn polyhedral_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
     let planes = shape.planes().expect("a convex polyhedral body");
@@ -360,7 +325,7 @@ fn polyhedral_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
             if nearest_all && inside(&x) > l0 / 2f64.sqrt() * (1.0 + 1e-9) {
                 return full;
             }
-            clipped_cell(&p.x0, i, &tree, &body, 2.5 * l0).volume()
+            nearest_first_cell(&p.x0, i, &tree, &body, 2.0 * l0).volume()
         })
         .collect()
 }
@@ -389,7 +354,7 @@ fn sectioned_volumes(p: &Particles<3, SLOTS>, sweep: &Sweep) -> Vec<f64> {
             if nearest_all && x.z > rc && x.z < length - rc && depth > rc {
                 return full;
             }
-            let cell = clipped_cell(&q, i, &tree, &bounds, 2.5 * l0);
+            let cell = nearest_first_cell(&q, i, &tree, &bounds, 2.0 * l0);
             volume_within(&cell, xy, depth, section, tol)
         })
         .collect()
