@@ -138,12 +138,16 @@ impl ConvexPolyhedron {
 /// the box (a convex polyhedron, [`Shape3::planes`]); for a prism and a cylinder, bodies with
 /// a section along an axis, by integrating the area of each cell's slices within the section
 /// along the axis ([`volume_in_section`]; the sum is within 1e-11 of the body's volume on
-/// the test bodies).
+/// the test bodies). A particle with its 12 nearest neighbours, farther than the cell's
+/// circumradius L0/√2 from the boundary, keeps the full cell without clipping.
 pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
-    match shape.sweep() {
-        Some(sweep) => sectioned_volumes(p, &sweep),
-        None => polyhedral_volumes(p, shape),
-    }
+    let l0 = p.spacing;
+    let full = FullCell {
+        volume: cell_volume(l0),
+        circumradius: l0 / 2f64.sqrt() * (1.0 + 1e-9),
+        has_nearest: &|i| p.neighbours[i][..SECOND].iter().all(|&j| j != NONE),
+    };
+    cells(&p.x0, shape, l0, 1e-12 * full.volume, Some(&full))
 }
 
 /// The Voronoi cell volumes of any particle set in `shape` (random particles, SPPM in 3D;
@@ -153,33 +157,61 @@ pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> 
 /// tests: within 1e-9 on a box, a cylinder and the dog-bone prism). `spacing`: the mean
 /// spacing L0, the scale of the cells' first guess of their reach.
 pub fn clipped_volumes(x: &[P], shape: &Shape3, spacing: f64) -> Vec<f64> {
+    cells(x, shape, spacing, 1e-12 * spacing.powi(3), None)
+}
+
+/// The cell a lattice particle has without clipping (the FCC's rhombic dodecahedron), kept by
+/// a particle with all its nearest neighbours lying deeper than the circumradius.
+struct FullCell<'a> {
+    volume: f64,
+    circumradius: f64,
+    has_nearest: &'a (dyn Fn(usize) -> bool + Sync),
+}
+
+/// The clipped cell volumes of particles `x` in `shape` (cells built by
+/// [`nearest_first_cell`], reach 2·`spacing`; `tol` for [`volume_in_section`]); particles
+/// that keep a `full` cell are not clipped.
+fn cells(x: &[P], shape: &Shape3, spacing: f64, tol: f64, full: Option<&FullCell>) -> Vec<f64> {
+    let keeps_full = |i: usize, deep: &dyn Fn(f64) -> bool| {
+        full.filter(|f| (f.has_nearest)(i) && deep(f.circumradius))
+            .map(|f| f.volume)
+    };
     match shape.sweep() {
         Some(sweep) => {
+            let (section, length) = (&sweep.section, sweep.length);
             let q: Vec<P> = x.iter().map(|x| sweep.local(x)).collect();
             let bounds = sweep_bounds(&sweep);
             let tree = tree_of(&q);
-            let tol = 1e-12 * spacing.powi(3);
             (0..q.len())
                 .into_par_iter()
                 .map(|i| {
-                    let cell = nearest_first_cell(&q, i, &tree, &bounds, 2.0 * spacing);
                     let xy = Vector2::new(q[i].x, q[i].y);
-                    volume_within(
-                        &cell,
-                        xy,
-                        depth_in(&sweep.section, &xy),
-                        &sweep.section,
-                        tol,
-                    )
+                    let depth = depth_in(section, &xy);
+                    let z = q[i].z;
+                    if let Some(v) = keeps_full(i, &|rc| z > rc && z < length - rc && depth > rc) {
+                        return v;
+                    }
+                    let cell = nearest_first_cell(&q, i, &tree, &bounds, 2.0 * spacing);
+                    volume_within(&cell, xy, depth, section, tol)
                 })
                 .collect()
         }
         None => {
+            let planes = shape.planes().expect("a convex polyhedral body");
             let body = body_polyhedron(shape);
             let tree = tree_of(x);
             (0..x.len())
                 .into_par_iter()
-                .map(|i| nearest_first_cell(x, i, &tree, &body, 2.0 * spacing).volume())
+                .map(|i| {
+                    let inside = |rc: f64| {
+                        let d = planes.iter().map(|(n, c)| c - n.dot(&x[i]));
+                        d.fold(f64::INFINITY, f64::min) > rc
+                    };
+                    if let Some(v) = keeps_full(i, &inside) {
+                        return v;
+                    }
+                    nearest_first_cell(x, i, &tree, &body, 2.0 * spacing).volume()
+                })
                 .collect()
         }
     }
@@ -302,62 +334,6 @@ fn tree_of(x: &[P]) -> RTree<GeomWithData<[f64; 3], usize>> {
             .map(|(i, x)| GeomWithData::new([x.x, x.y, x.z], i))
             .collect(),
     )
-}
-
-/// The cells of a box-shaped body: the body's convex polyhedron clipped by the bisectors.
-fn polyhedral_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> {
-    let planes = shape.planes().expect("a convex polyhedral body");
-    let body = body_polyhedron(shape);
-    let l0 = p.spacing;
-    let full = cell_volume(l0);
-    let inside = |x: &P| {
-        planes
-            .iter()
-            .map(|(n, c)| c - n.dot(x))
-            .fold(f64::INFINITY, f64::min)
-    };
-    let tree = tree_of(&p.x0);
-    (0..p.len())
-        .into_par_iter()
-        .map(|i| {
-            let x = p.x0[i];
-            let nearest_all = p.neighbours[i][..SECOND].iter().all(|&j| j != NONE);
-            if nearest_all && inside(&x) > l0 / 2f64.sqrt() * (1.0 + 1e-9) {
-                return full;
-            }
-            nearest_first_cell(&p.x0, i, &tree, &body, 2.0 * l0).volume()
-        })
-        .collect()
-}
-
-/// The cells of a swept body (a prism, a cylinder), in its local coordinates (the section
-/// in x, y through z ∈ [0, length]): each cell clipped by the bisectors and the two end
-/// planes, then its volume within the section ([`volume_in_section`]). A particle with its
-/// 12 nearest neighbours farther than the cell's circumradius L0/√2 from the boundary keeps
-/// the full cell.
-fn sectioned_volumes(p: &Particles<3, SLOTS>, sweep: &Sweep) -> Vec<f64> {
-    let (section, length) = (&sweep.section, sweep.length);
-    let q: Vec<P> = p.x0.iter().map(|x| sweep.local(x)).collect();
-    let l0 = p.spacing;
-    let full = cell_volume(l0);
-    let rc = l0 / 2f64.sqrt() * (1.0 + 1e-9);
-    let bounds = sweep_bounds(sweep);
-    let tree = tree_of(&q);
-    let tol = 1e-12 * full;
-    (0..p.len())
-        .into_par_iter()
-        .map(|i| {
-            let x = q[i];
-            let xy = Vector2::new(x.x, x.y);
-            let nearest_all = p.neighbours[i][..SECOND].iter().all(|&j| j != NONE);
-            let depth = depth_in(section, &xy);
-            if nearest_all && x.z > rc && x.z < length - rc && depth > rc {
-                return full;
-            }
-            let cell = nearest_first_cell(&q, i, &tree, &bounds, 2.0 * l0);
-            volume_within(&cell, xy, depth, section, tol)
-        })
-        .collect()
 }
 
 /// The polygon where the plane at height z cuts a convex polyhedron, projected on (x, y),
