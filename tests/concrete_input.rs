@@ -155,8 +155,8 @@ fn bad_material_input_is_refused() {
     assert!(e.contains("material.E") && e.contains("missing"), "{e}");
 }
 
-/// The crack band defaults by discretisation (lattices 2.8, random particles 3.2, both
-/// measured: benchmarks/RESULTS.md), is recorded with its source, and a scene's value wins.
+/// The crack band defaults by discretisation (2D: lattices 2.8, random particles 3.2; 3D: FCC
+/// 3.3, random particles 4.2; all measured: benchmarks/RESULTS.md), is recorded with its source, and a scene's value wins.
 #[test]
 fn crack_band_defaults_by_discretisation() {
     let band = |s: &Scene| s.concrete.as_ref().unwrap().crack_band.unwrap();
@@ -176,4 +176,14 @@ fn crack_band_defaults_by_discretisation() {
         .derived
         .iter()
         .any(|d| d.key == "concrete.crack_band" && d.source == "scene"));
+    // 3D: the FCC lattice 3.3, random particles 4.2 (benchmarks/RESULTS.md, "Concrete in
+    // 3D" and "Random particles in 3D")
+    let prism = |o: &[&str]| {
+        let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+        Scene::from_file(Path::new("lattices/tension_prism_3d.toml"), &o).unwrap()
+    };
+    assert_eq!(band(&prism(&[])), 3.3);
+    let random3 = prism(&["discretisation.lattice=\"random\""]);
+    assert_eq!(band(&random3), 4.2);
+    assert_eq!(random3.derived_value("concrete.crack_band"), Some(4.2));
 }
