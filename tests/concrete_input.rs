@@ -156,7 +156,8 @@ fn bad_material_input_is_refused() {
 }
 
 /// The crack band defaults by discretisation (2D: lattices 2.8, random particles 3.2; 3D: FCC
-/// 3.3, random particles 4.2; all measured: benchmarks/RESULTS.md), is recorded with its source, and a scene's value wins.
+/// 3.3, random particles 4.2; all measured: benchmarks/RESULTS.md), is recorded with its
+/// source, and a scene's value wins.
 #[test]
 fn crack_band_defaults_by_discretisation() {
     let band = |s: &Scene| s.concrete.as_ref().unwrap().crack_band.unwrap();
@@ -176,8 +177,6 @@ fn crack_band_defaults_by_discretisation() {
         .derived
         .iter()
         .any(|d| d.key == "concrete.crack_band" && d.source == "scene"));
-    // 3D: the FCC lattice 3.3, random particles 4.2 (benchmarks/RESULTS.md, "Concrete in
-    // 3D" and "Random particles in 3D")
     let prism = |o: &[&str]| {
         let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
         Scene::from_file(Path::new("lattices/tension_prism_3d.toml"), &o).unwrap()
