@@ -120,18 +120,18 @@ where
     /// a damaged bond jumps where its stretch changes sign, the held problem has no smooth
     /// equilibrium, and the iterations chatter about S_e = 0 (measured: the tension block's
     /// peak increment stuck at 0.7–1.7% out of balance for 20,000 iterations).
-    shortened: Vec<u32>,
+    shortened: Vec<u64>,
     /// Bits of the slots whose branch flipped at a commit since [`Self::unlock_branches`]:
     /// a second flip is refused (the bond keeps its branch), so that a bond whose equilibrium
     /// stretch changes sign with its branch cannot keep the iterations from settling.
-    flipped: Vec<u32>,
+    flipped: Vec<u64>,
     /// The law state at the start of the quasi-static solver's load increment
     /// ([`Self::begin_increment`]; allocated by [`Self::freeze`], empty before).
     start: Aligned<L::State>,
     /// The plastic stretch states at the start of the increment.
     sps_start: Aligned<[f64; K]>,
     /// [`Self::shortened`] at the start of the increment.
-    shortened_start: Vec<u32>,
+    shortened_start: Vec<u64>,
 }
 
 /// The criteria (initiation, yield) of a particle read the volume-weighted mean of the damaged
@@ -346,9 +346,9 @@ where
         &self,
         m: &Mechanics<D, K>,
         x: &[SVector<f64, D>],
-        old: Option<&[u32]>,
-    ) -> Vec<u32> {
-        assert!(K <= 32, "the branch bits hold at most 32 slots");
+        old: Option<&[u64]>,
+    ) -> Vec<u64> {
+        const { assert!(K <= 64, "the branch bits hold at most 64 slots") };
         (0..m.len())
             .into_par_iter()
             .with_min_len(1024)
