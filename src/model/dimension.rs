@@ -147,6 +147,21 @@ pub trait Dimension<const D: usize>: Copy + Default + Debug + Send + Sync + 'sta
     /// out-of-plane σ_zz ([`out_of_plane_stress`]) — the pair the concrete
     /// criteria take (§8, `damage::initiates`).
     fn principal_stress_extremes(s: &Tensor<D>, nu: f64, plane: Plane) -> (f64, f64);
+    /// An upper bound on σ_max and a lower bound on σ_min of
+    /// [`Dimension::principal_stress_extremes`], cheaper than the extremes, for tests that
+    /// are monotone in them (initiation, `damage::initiates`): where the bounds fail the test,
+    /// the extremes fail it too. 2D: the extremes themselves.
+    #[inline(always)]
+    fn principal_stress_bounds(s: &Tensor<D>, nu: f64, plane: Plane) -> (f64, f64) {
+        Self::principal_stress_extremes(s, nu, plane)
+    }
+    /// Effective strain (4.17) of a strain tensor, √(½·Σ(ε_i − ε_j)²) over its principal
+    /// strains ([`Dimension::principal_strains`]). 2D: from the principal strains.
+    #[inline(always)]
+    fn effective_strain(e: &Tensor<D>, nu: f64, plane: Plane) -> f64 {
+        let (e1, e2, e3) = Self::principal_strains(e, nu, plane);
+        crate::model::damage::effective_strain(e1, e2, e3)
+    }
     /// Von Mises equivalent stress √(3/2)·‖σ_dev‖ ((3.39), (3.40)); in 2D with σ_zz from the
     /// plane (plane stress 0, plane strain ν·(σxx+σyy)).
     fn equivalent_stress(s: &Tensor<D>, nu: f64, plane: Plane) -> f64;
@@ -674,6 +689,22 @@ impl Dimension<3> for Dim<3> {
     fn principal_stress_extremes(s: &Matrix3<f64>, _nu: f64, _plane: Plane) -> (f64, f64) {
         let [s1, _, s3] = principal_values_3(s);
         (s1, s3)
+    }
+    /// σ_m ± (2/3)·σ_vM, widened by 1e-12 of (|σ_m| + σ_vM) against round-off: the deviator's
+    /// eigenvalues lie within ±2·√(J2/3) = ±(2/3)·σ_vM (equality in uniaxial stress), so no
+    /// eigenvalue solve; `nu` and `plane` are ignored.
+    #[inline]
+    fn principal_stress_bounds(s: &Matrix3<f64>, _nu: f64, _plane: Plane) -> (f64, f64) {
+        let m = (s[(0, 0)] + s[(1, 1)] + s[(2, 2)]) / 3.0;
+        let vm = <Self as Dimension<3>>::von_mises(s);
+        let r = 2.0 / 3.0 * vm + 1e-12 * (m.abs() + vm);
+        (m + r, m - r)
+    }
+    /// The von Mises form of the strain tensor (the same invariant, no eigenvalue solve);
+    /// `nu` and `plane` are ignored.
+    #[inline]
+    fn effective_strain(e: &Matrix3<f64>, _nu: f64, _plane: Plane) -> f64 {
+        <Self as Dimension<3>>::von_mises(e)
     }
     /// The full von Mises stress; `nu` and `plane` are ignored.
     #[inline]
@@ -1206,6 +1237,55 @@ mod tests {
             worst = worst.max(check_principal_3(&t, &format!("case {case}")));
         }
         eprintln!("principal_values_3: worst error {worst:e} of ‖t‖");
+    }
+
+    /// The 3D stress bounds enclose the extremes (so a bound that fails the initiation test
+    /// settles it) and meet them in uniaxial stress; the 3D effective strain from the
+    /// invariants is (4.17) of the principal strains.
+    #[test]
+    fn stress_bounds_enclose_the_extremes_and_effective_strain_is_invariant() {
+        let mut r = ChaCha20Rng::seed_from_u64(11);
+        for case in 0..20000 {
+            let sc = scale(&mut r, 10.0);
+            let q = rotation(&mut r);
+            let l = Vector3::new(
+                range(&mut r, -sc, sc),
+                range(&mut r, -sc, sc),
+                range(&mut r, -sc, sc),
+            );
+            // uniaxial (two zero principal values) in every fourth case
+            let l = if case % 4 == 0 {
+                Vector3::new(l.x, 0.0, 0.0)
+            } else {
+                l
+            };
+            let t = q * Matrix3::from_diagonal(&l) * q.transpose();
+            let t = Matrix3::from_fn(|i, j| if i >= j { t[(i, j)] } else { t[(j, i)] });
+            let (hi, lo) = <D3 as Dimension<3>>::principal_stress_extremes(&t, 0.2, Plane::Stress);
+            let (bh, bl) = <D3 as Dimension<3>>::principal_stress_bounds(&t, 0.2, Plane::Stress);
+            assert!(
+                bh >= hi && bl <= lo,
+                "case {case}: ({bh}, {bl}) against ({hi}, {lo})"
+            );
+            let tol = 1e-12 * t.norm();
+            if case % 4 == 0 {
+                // uniaxial σ: the bound on the extreme of σ's sign is σ itself, widened by
+                // the round-off allowance (4/3)·1e-12·|σ|
+                let got = if l.x > 0.0 { bh } else { bl };
+                assert!(
+                    (got - l.x).abs() <= 3.0 * tol,
+                    "case {case}: {got} against {}",
+                    l.x
+                );
+            }
+            let (e1, e2, e3) = <D3 as Dimension<3>>::principal_strains(&t, 0.2, Plane::Stress);
+            let want = crate::model::damage::effective_strain(e1, e2, e3);
+            let got = <D3 as Dimension<3>>::effective_strain(&t, 0.2, Plane::Stress);
+            assert!(
+                (got - want).abs() <= tol,
+                "case {case}: {got} against {want}"
+            );
+        }
     }
 
     // -- strain fit is exact on affine fields -----------------------------------------------

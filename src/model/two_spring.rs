@@ -129,28 +129,39 @@ where
             Dim::<D>::stress_of_strain(&(self.d * (law.e / self.law.e)), &eps_d)
         };
 
-        // Tensile damage (§8).
+        // Tensile damage (§8). The initiation test is monotone in (σ_max, −σ_min), so bounds
+        // that fail it settle it without the principal stresses (in 3D an eigenvalue solve).
+        let mut sigma = None;
         let mut initiates_now = false;
         if law.tensile_damage && !p.initiated {
-            // σ_max, σ_min, with the out-of-plane σ_zz in 2D
-            let (hi, lo) =
-                Dim::<D>::principal_stress_extremes(&criteria_stress(), law.nu, law.plane);
-            initiates_now = damage::initiates(law, hi, lo);
+            let sigma = *sigma.get_or_insert_with(criteria_stress);
+            let (hi, lo) = Dim::<D>::principal_stress_bounds(&sigma, law.nu, law.plane);
+            if damage::initiates(law, hi, lo) {
+                // σ_max, σ_min, with the out-of-plane σ_zz in 2D
+                let (hi, lo) = Dim::<D>::principal_stress_extremes(&sigma, law.nu, law.plane);
+                initiates_now = damage::initiates(law, hi, lo);
+            }
         }
         if !(FULL || p.initiated || initiates_now) {
             return;
         }
-        let (e1, e2, e3) = Dim::<D>::principal_strains(&eps, law.nu, law.plane);
-        if initiates_now {
-            p.initiated = true;
-            p.eps_init = e1;
-        }
-        if p.initiated {
+        // The principal strains where tensile damage needs ε_I; elsewhere ε_eff comes from
+        // the invariants (no eigenvalue solve in 3D).
+        let principal = (p.initiated || initiates_now)
+            .then(|| Dim::<D>::principal_strains(&eps, law.nu, law.plane));
+        if let Some((e1, _, _)) = principal {
+            if initiates_now {
+                p.initiated = true;
+                p.eps_init = e1;
+            }
             let band = law.crack_band * b.length();
             p.wt = p.wt.max(damage::tensile_damage(law, band, e1, p.eps_init));
         }
         if FULL {
-            let eps_eff = damage::effective_strain(e1, e2, e3);
+            let eps_eff = match principal {
+                Some((e1, e2, e3)) => damage::effective_strain(e1, e2, e3),
+                None => Dim::<D>::effective_strain(&eps, law.nu, law.plane),
+            };
             // Compressive damage (§9).
             if law.compressive_damage {
                 p.wc = p.wc.max(damage::compressive_damage(law, p.wt, eps_eff));
@@ -159,8 +170,8 @@ where
             // the undamaged force states (3.44).
             if law.plasticity && p.wc < 1.0 {
                 let f_eff = plasticity::effective_yield(law.fy, law.fult, law.eps_ult, eps_eff);
-                let ratio =
-                    Dim::<D>::equivalent_stress(&criteria_stress(), law.nu, law.plane) / f_eff;
+                let sigma = sigma.unwrap_or_else(criteria_stress);
+                let ratio = Dim::<D>::equivalent_stress(&sigma, law.nu, law.plane) / f_eff;
                 if ratio >= 1.0 {
                     let mut fs = [0.0; K];
                     for (k, f) in fs.iter_mut().enumerate() {
