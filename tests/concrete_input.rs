@@ -33,8 +33,12 @@ end_periods = 2.0
 "#;
 
 fn scene(overrides: &[&str]) -> Result<Scene, String> {
+    scene_of(CONCRETE, overrides)
+}
+
+fn scene_of(text: &str, overrides: &[&str]) -> Result<Scene, String> {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Scene::from_toml_str(CONCRETE, &o).map_err(|e| e.to_string())
+    Scene::from_toml_str(text, &o).map_err(|e| e.to_string())
 }
 
 fn refused(overrides: &[&str], fragments: &[&str]) {
@@ -177,10 +181,8 @@ fn crack_band_defaults_by_discretisation() {
         .derived
         .iter()
         .any(|d| d.key == "concrete.crack_band" && d.source == "scene"));
-    let prism = |o: &[&str]| {
-        let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
-        Scene::from_file(Path::new("lattices/tension_prism_3d.toml"), &o).unwrap()
-    };
+    let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
+    let prism = |o: &[&str]| scene_of(&text, o).unwrap();
     assert_eq!(band(&prism(&[])), 3.3);
     let random3 = prism(&["discretisation.lattice=\"random\""]);
     assert_eq!(band(&random3), 4.2);

@@ -134,7 +134,7 @@ where
         let mut sigma = None;
         let mut initiates_now = false;
         if law.tensile_damage && !p.initiated {
-            let sigma = *sigma.get_or_insert_with(criteria_stress);
+            let sigma = *sigma.insert(criteria_stress());
             let (hi, lo) = Dim::<D>::principal_stress_bounds(&sigma, law.nu, law.plane);
             if damage::initiates(law, hi, lo) {
                 // σ_max, σ_min, with the out-of-plane σ_zz in 2D
