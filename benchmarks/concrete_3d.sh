@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the shipped 3D concrete scenes (FCC lattice; issue "3D") and prints, per scene, the
+# Runs the shipped 3D concrete scenes (FCC lattice) and prints, per scene, the
 # peak force against its reference, the dissipated energy against G_f·A (tension prism), the
 # quasi-static ratio K/U up to the peak, the particles and the run time.
 # Usage: benchmarks/concrete_3d.sh [scene ...] [-- --set key=value ...]
@@ -28,7 +28,7 @@ import json, math, sys
 s = json.load(open(sys.argv[1]))
 name = sys.argv[2]
 v = {d["key"]: d["value"] for d in s["material_values"]}
-# references: f't·A; (5.6); the dog-bone's f't·0.6·D·t; seed 000's bond-based peaks
+# references: f't·A; (5.6); the dog-bone's f't·0.6·D·t; Hobbs's (2021) bond-based peaks
 ref = {
     "tension_prism_3d": v["ft"] * 0.15 * 0.15,
     "split_cylinder_3d": math.pi / 2 * v["ft"] * 0.15 * 0.30 / (1 - (0.025 / 0.15) ** 2) ** 1.5,

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The 3D elastic kernel against LAMMPS peridynamics on the same FCC block (issue 15).
+# The 3D elastic kernel against LAMMPS peridynamics on the same FCC block.
 #
 #   bash benchmarks/fcc_vs_lammps.sh [PARTICLES, default 100000] [SPPM_STEPS, default 200]
 #
@@ -8,7 +8,7 @@
 # nearest spacing is a/√2 and 4 atoms per a³; horizon 1.05·a takes the 12 nearest and the 6
 # second neighbours), and `sppm bench --dim 3` (`bench::fcc_block`, the same points). Both
 # have 4N³ + 6N² + 3N + 1 particles; N is the one nearest PARTICLES. Each code runs on 1 and
-# 2 threads (sppm) / MPI processes (LAMMPS: /work/shared/peers/lammps/bench.sh, which installs
+# 2 threads (sppm) / MPI processes (LAMMPS: the script named by LAMMPS_BENCH, e.g. one that installs
 # Debian's lammps package with apt if `lmp` is missing, times 400 − 100 steps of peri/lps and
 # so excludes its set-up; sppm excludes set-up too). Prints every rate, the per-core rates
 # and the ratios sppm/LAMMPS, as a Markdown table. Set SPPM to another binary, LAMMPS_STYLE
@@ -19,7 +19,7 @@ root=$(dirname "$here")
 particles=${1:-100000}
 steps=${2:-200}
 sppm=${SPPM:-$root/target/release/sppm}
-lammps=${LAMMPS_BENCH:-/work/shared/peers/lammps/bench.sh}
+lammps=${LAMMPS_BENCH:?set LAMMPS_BENCH to a script that times LAMMPS on the block}
 style=${LAMMPS_STYLE:-peri/lps}
 [ -x "$sppm" ] || (cd "$root" && cargo build --release -q)
 # N with 4N³ + 6N² + 3N + 1 nearest PARTICLES

@@ -1,6 +1,6 @@
 #!/bin/bash
 # The Monte Carlo size-effect study of benchmarks/RESULTS.md ("Random fields and the Monte Carlo
-# size effect (issue 5)"): dog-bones A–E × 100 realisations and F × N_F (default 40), two jobs
+# size effect"): dog-bones A–E × 100 realisations and F × N_F (default 40), two jobs
 # at a time, then one report over A–F and the realisations per hour per size.
 #
 #   bash benchmarks/montecarlo.sh [N_F]

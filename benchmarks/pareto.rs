@@ -1,11 +1,11 @@
-//! Run time against error (issue 4, item 3).
+//! Run time against error.
 //!
 //! `cargo run --release --example pareto -- SCENE [--threads 2] [--out DIR] [--set k=v]...`
 //!
 //! Sweeps the lattice spacing, the time-step safety factor, the loading time (fundamental
 //! periods), internal and external damping one at a time around the scene's values, plus
 //! coarse-and-fast combinations; and the quasi-static solver (`solver.method =
-//! "quasi_static"`, issue 16) at ½, 1, 2 and 4 × the scene's load increments and at spacings
+//! "quasi_static"`) at ½, 1, 2 and 4 × the scene's load increments and at spacings
 //! ×2, ×1.5 and ×0.7, measured against the reference of the explicit runs alone. The runs go
 //! one after another, each on `--threads` threads, so that their wall times compare. Each
 //! finished run is appended to `runs.csv` at once; a second invocation skips the runs already

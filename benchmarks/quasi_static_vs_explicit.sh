@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The quasi-static solver (solver.method = "quasi_static", docs/quasi_static.md) against the
-# explicit solver and the adaptive relaxation on the shipped 2D concrete scenes (issue 16):
+# explicit solver and the adaptive relaxation on the shipped 2D concrete scenes:
 # peak force, the force at equal displacement down the softening branch to 30% of the
 # peak, the dissipated energy, and the wall time to the peak. Reference: the explicit run
 # loaded 4× more slowly (loading.end_periods × 4) at solver.safety = 0.5 ("ref").

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Energy dissipated in uniaxial tension against G_f × crack area (MODEL.md §8): the Table 1
-# block of 002, 150 mm wide and 150 mm thick, at L0 = 10 and 5 mm, for both readings of the
+# Energy dissipated in uniaxial tension against G_f × crack area (docs/model.md §8): the Table 1
+# block of Nikravesh Kazeroni (2017), 150 mm wide and 150 mm thick, at L0 = 10 and 5 mm, for both readings of the
 # crack opening (total, as written; inelastic, from initiation) and crack bands of 2 L0
 # (4.13 as written) and 2.8 L0 (the default). HEIGHT is the block height (default 0.1 m, a
-# block that separates stably; 0.3 m is VALIDATION.md §B's, which snaps back after the peak).
+# block that separates stably; 0.3 m is docs/validation.md §B's, which snaps back after the peak).
 # Usage: benchmarks/tension_energy.sh   (needs python3 to read summary.json)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -4,7 +4,7 @@
 //! slots of the lattice (`solver::kernel`) or compressed sparse rows (`solver::csr_kernel`).
 //!
 //! `--dim 3` times the elastic slot kernel on a cube of FCC lattice (18 slots: 12 nearest
-//! and 6 second neighbours with the modulus a + c, MODEL.md §3 with its erratum), built by
+//! and 6 second neighbours with the modulus a + c, docs/model.md §3 with its erratum), built by
 //! [`fcc_block`] here: the same block as LAMMPS's `lattice fcc a` with `region block 0 N`
 //! (benchmarks/fcc_vs_lammps.sh). The lattice generator `discretise::fcc` had not landed when
 //! this was written; the block needs no clipping to a shape.
@@ -127,7 +127,7 @@ pub fn bytes_per_particle(kernel: KernelSet, dim: usize) -> usize {
 /// Time `steps` steps of `kernel` (bond dampers on, as in the shipped scenes) on a square
 /// block of about `particles` particles on `threads` threads, with the bonds in `layout`
 /// (the CSR layout runs the elastic kernel only). The tension and full kernels
-/// run the Table 1 concrete of 002 under an equibiaxial strain of 0.9e-4 (1.03·f't/E; the
+/// run the Table 1 concrete of Nikravesh Kazeroni (2017) under an equibiaxial strain of 0.9e-4 (1.03·f't/E; the
 /// principal stress E·ε/(1 − ν) is 1.29·f't), so every particle initiates in the first
 /// step and then softens: each timed step evaluates every particle's tensile damage (and,
 /// with the full kernel, compressive damage and the yield test) and every bond's damage
@@ -221,7 +221,7 @@ fn strained_model<const D: usize, const K: usize>(
     (mech, st)
 }
 
-/// The bench's damage model for `kernel` (Table 1 concrete of 002; `None` for the elastic
+/// The bench's damage model for `kernel` (Table 1 concrete of Nikravesh Kazeroni (2017); `None` for the elastic
 /// kernel), checked to choose that kernel.
 fn damage_model<const D: usize, const K: usize>(
     p: &crate::discretise::Particles<D, K>,
@@ -361,7 +361,7 @@ pub fn fcc_block(cells: usize, l0: f64) -> Particles<3, 18> {
 
 /// `sppm bench --dim 3`: the elastic slot kernel (bond dampers on, as in 2D) on the FCC cube
 /// of [`fcc_block`] nearest `particles` particles, under a homogeneous strain of 1e-4; or a
-/// damage kernel (`tension`, `full`) with the Table 1 concrete of 002 under a triaxial strain
+/// damage kernel (`tension`, `full`) with the Table 1 concrete of Nikravesh Kazeroni (2017) under a triaxial strain
 /// of 0.9e-4 (the principal stress E·ε/(1 − 2ν) is 1.72·f't), so that, as in 2D, every
 /// particle initiates in the first step and then softens.
 pub fn bench_fcc(

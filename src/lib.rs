@@ -1,7 +1,7 @@
 //! sppm: the state-based peridynamic lattice model (SPLM) and its random-particle
 //! generalisation (SPPM) for fracture of concrete.
 //!
-//! The data flow (ARCHITECTURE.md): [`scene::Scene`] → [`geometry`] → [`discretise`] →
+//! The data flow (docs/architecture.md): [`scene::Scene`] → [`geometry`] → [`discretise`] →
 //! [`model`] → [`solver`] → [`output`]. A run is [`run::run`]; the CLI is a thin caller.
 //!
 //! # Layers

@@ -1,4 +1,4 @@
-//! Random-field material properties (MODEL.md §12).
+//! Random-field material properties (docs/model.md §12).
 //!
 //! A property such as f't, E or G_f is drawn per particle as `marginal.map(g(x))`, where g is a
 //! standard Gaussian random field (mean 0, variance 1) with correlation ρ(r) and correlation
@@ -105,7 +105,7 @@ fn bad(name: &'static str, value: f64, allowed: &'static str) -> FieldError {
     }
 }
 
-/// Correlation function ρ(r) of the Gaussian field (MODEL.md §12).
+/// Correlation function ρ(r) of the Gaussian field (docs/model.md §12).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Correlation {
     /// ρ(r) = exp(−r/ℓ).
@@ -152,7 +152,7 @@ struct Grid {
     info: EmbeddingInfo,
 }
 
-/// A standard Gaussian random field (mean 0, variance 1) over an axis-aligned box (MODEL.md §12).
+/// A standard Gaussian random field (mean 0, variance 1) over an axis-aligned box (docs/model.md §12).
 #[derive(Debug, Clone)]
 pub struct GaussianField {
     correlation: Correlation,
@@ -494,7 +494,7 @@ pub fn normal_quantile(p: f64) -> f64 {
 }
 
 /// Marginal distribution of a property, mapping a standard normal g to the property value by
-/// matching probabilities, value = F⁻¹(Φ(g)) (MODEL.md §12). Build with the checked
+/// matching probabilities, value = F⁻¹(Φ(g)) (docs/model.md §12). Build with the checked
 /// constructors.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Marginal {

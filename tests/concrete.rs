@@ -1,6 +1,6 @@
-//! The damage and plasticity kernel (MODEL.md §6–9): it reduces to the elastic kernel without
+//! The damage and plasticity kernel (docs/model.md §6–9): it reduces to the elastic kernel without
 //! damage, conserves energy, never heals, a broken particle transmits nothing, and a block in
-//! uniaxial tension reaches f't·A and dissipates G_f per unit crack area (VALIDATION.md §B).
+//! uniaxial tension reaches f't·A and dissipates G_f per unit crack area (docs/validation.md §B).
 
 mod common;
 
@@ -89,7 +89,7 @@ fn fully_damaged_particle_transmits_no_force() {
     assert!(total.norm() <= 1e-12 * scale, "Σ forces {total:?}");
 }
 
-/// VALIDATION.md §B, uniaxial tension, at L0 = 10 mm and 5 mm: the peak within 5% of f't·A;
+/// docs/validation.md §B, uniaxial tension, at L0 = 10 mm and 5 mm: the peak within 5% of f't·A;
 /// the energy dissipated by damage (external work minus kinetic, elastic and damper energy)
 /// within 10% of G_f × A, A the one crack's area; damage never decreases, the dissipated
 /// energy never decreases (to 0.1% of G_f·A), and the run is quasi-static to the peak.
@@ -157,7 +157,7 @@ fn uniaxial_tension_reaches_ft_and_dissipates_gf() {
     }
 }
 
-/// Plasticity alone (MODEL.md §9, damage off): a block in uniaxial compression, well past
+/// Plasticity alone (docs/model.md §9, damage off): a block in uniaxial compression, well past
 /// yield (ε_yy ≈ −0.44% in its middle; with damage off the linear hardening goes on past
 /// ε_ult), carries the hardening yield stress F_eff(ε_eff) = f_y + (f_ult −
 /// f_y)·ε_eff/ε_ult (4.15), with ε_eff (4.17) from the strains fitted over the middle of the

@@ -1,13 +1,13 @@
 //! The concrete kernel and the two-spring law run in 3D from the same source as in 2D
-//! (issue 12, dimension as a type): on a small 3D body under a uniform uniaxial strain
+//! (dimension as a type): on a small 3D body under a uniform uniaxial strain
 //! ε_xx, Rankine initiation happens exactly where the 3D isotropic stress
 //! σ_xx = E(1−ν)/((1+ν)(1−2ν))·ε_xx reaches f't, and the initiation strain recorded is ε_xx.
 //!
 //! The body is a 4×4×4 simple-cubic block with 18 slots per particle (6 nearest neighbours
 //! and 12 face diagonals), built here: the test needs only a body whose bonds span 3D.
 //!
-//! On the FCC lattice (issue "3D") the damage kernel carries the second-neighbour modulus
-//! a + c (MODEL.md §3 erratum) and the weighted dilatation: undamaged, its forces are the
+//! On the FCC lattice the damage kernel carries the second-neighbour modulus
+//! a + c (docs/model.md §3 erratum) and the weighted dilatation: undamaged, its forces are the
 //! elastic kernel's; damaged, its energy is the potential of its forces.
 
 use nalgebra::Vector3;
@@ -179,7 +179,7 @@ fn strained(p: &Particles<3, 18>) -> Vec<Vector3<f64>> {
         .collect()
 }
 
-/// MODEL.md §3 erratum in the damage kernel: without damage its forces on the FCC lattice are
+/// docs/model.md §3 erratum in the damage kernel: without damage its forces on the FCC lattice are
 /// the elastic kernel's (second-neighbour bonds at a + c), to round-off; with damage fixed,
 /// its energy is the potential of its forces (−∂U/∂x_i = f_i by central differences), so the
 /// energy balance of a 3D run closes.

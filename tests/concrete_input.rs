@@ -1,4 +1,4 @@
-//! Concrete input (MODEL.md §11, VALIDATION.md §B–D): the correlations reproduce the derived
+//! Concrete input (docs/model.md §11, docs/validation.md §B–D): the correlations reproduce the derived
 //! values the validation cases quote, a scene value overrides a correlation, and bad
 //! material input is refused with one message naming the key, the value and what is allowed.
 
@@ -58,7 +58,7 @@ fn close(what: &str, got: f64, want: f64, rel: f64) {
     );
 }
 
-/// VALIDATION.md §B: E (ACI) ≈ 25.1 GPa, f't = 2.6168 MPa, G_f ≈ 81.4 N/m, COD_c ≈ 0.178 mm;
+/// docs/validation.md §B: E (ACI) ≈ 25.1 GPa, f't = 2.6168 MPa, G_f ≈ 81.4 N/m, COD_c ≈ 0.178 mm;
 /// the default Δmax is 1.5·COD_c. Tolerances: half a unit of the last digit quoted (f't:
 /// the table's rounding).
 #[test]
@@ -80,7 +80,7 @@ fn block_values_follow_aci_and_ceb_fip() {
     );
 }
 
-/// VALIDATION.md §C and §D through the shipped scenes (presets).
+/// docs/validation.md §C and §D through the shipped scenes (presets).
 #[test]
 fn shipped_scenes_derive_the_quoted_values() {
     let load = |f: &str| Scene::from_file(Path::new(f), &[]).unwrap();

@@ -41,7 +41,7 @@ fn block() -> Particles<2, 6> {
     })
 }
 
-/// Concrete-like micro-moduli (MODEL.md §3, 2D plane stress) varied per particle by ±10%,
+/// Concrete-like micro-moduli (docs/model.md §3, 2D plane stress) varied per particle by ±10%,
 /// with bond dampers (ξ_in = 0.2) and particle dampers (ξ_ex, none on every fifth particle),
 /// so that any mix-up of i and j or of bonds shows.
 fn mechanics(p: &Particles<2, 6>) -> Mechanics<2, 6> {
@@ -206,7 +206,7 @@ fn csr_from_slots_of_a_body_with_boundary() {
         .contains("no such particle"));
 }
 
-/// Random particles bonded where either end lists the other among its 6 nearest (MODEL.md
+/// Random particles bonded where either end lists the other among its 6 nearest (docs/model.md
 /// §1): the pairs come in both orders and twice; the CSR has one bond per pair, reverse of
 /// reverse is the identity, L0 is symmetric bit for bit and each row is sorted.
 #[test]

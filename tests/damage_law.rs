@@ -1,8 +1,8 @@
 //! A second damage law, written outside the crate against the `DamageLaw` trait alone, runs
-//! through the unchanged concrete kernel (issue 12: laws are addable without touching the
+//! through the unchanged concrete kernel (laws are addable without touching the
 //! kernel or the pipeline).
 //!
-//! The law is the simplest bond-based one of seed 000's family: brittle failure at a critical
+//! The law is the simplest bond-based one of Hobbs's (2021) family: brittle failure at a critical
 //! stretch s_c. A particle remembers whether any of its bonds has stretched beyond s_c; a bond
 //! whose particle has failed carries nothing (d = 0). On a block pulled apart uniformly the
 //! force must then follow the elastic line up to the stretch s_c and drop to zero after it.

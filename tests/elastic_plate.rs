@@ -1,4 +1,4 @@
-//! VALIDATION.md §A: E and ν of a plate in uniaxial tension, with and without the surface
+//! docs/validation.md §A: E and ν of a plate in uniaxial tension, with and without the surface
 //! correction, in plane stress and plane strain, and the stiffness at lattice rotations.
 //!
 //! The plate (100 × 200 mm, L0 = 1 mm, ν = 0.2) is solved statically (small strain) with the
@@ -16,7 +16,7 @@ const W: f64 = 0.1;
 const H: f64 = 0.2;
 const T: f64 = 0.05;
 const L0: f64 = 0.001;
-/// VALIDATION.md §A.
+/// docs/validation.md §A.
 const TOL: f64 = 0.01;
 
 fn measure(rotation: f64, plane: &str, correction: bool) -> (f64, f64) {

@@ -1,4 +1,4 @@
-//! The 3D FCC lattice (issue "3D"): scenes of solid bodies and their bad input, the body's
+//! The 3D FCC lattice: scenes of solid bodies and their bad input, the body's
 //! volume at any rotation and offset, and the elastic block against (E, ν).
 
 mod common;

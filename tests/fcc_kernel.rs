@@ -1,4 +1,4 @@
-//! The FCC second-neighbour modulus in the elastic kernels (issue 15; MODEL.md §3 with its
+//! The FCC second-neighbour modulus in the elastic kernels (docs/model.md §3 with its
 //! erratum: F_s,ij = (a_i + c_i·[j ∈ N_II])·S_ij + b_i·θ_i).
 //!
 //! The linear patch test on a small FCC block built here by hand (integer points (i, j, k)

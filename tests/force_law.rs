@@ -1,4 +1,4 @@
-//! One force law (issue 12): the SPLM bond force, energy and stress of random configurations,
+//! One force law: the SPLM bond force, energy and stress of random configurations,
 //! computed through every caller's path, agree.
 //!
 //! Paths: the elastic step kernel (`kernel::particle_force` after `pass_dilatation`), the

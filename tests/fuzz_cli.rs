@@ -1,4 +1,4 @@
-//! Fuzzing the command line (issue 11): random counts for `bench`, `study objectivity` and
+//! Fuzzing the command line: random counts for `bench`, `study objectivity` and
 //! `study montecarlo`, and random `--set` values for `run` and `check` of a tiny scene. Every
 //! command must end without a panic, and none may exit 0 with a NaN result. Each command is
 //! given a few seconds (a huge but acceptable count simply runs; it is stopped there), so

@@ -1,6 +1,6 @@
 //! Golden results: every shipped scene gives, bit for bit, the peak force, dissipated energy,
 //! step count and particle count recorded before the pipeline was made generic over
-//! discretisation and dimension (issue 12). Recorded with the binary of commit f185737
+//! discretisation and dimension. Recorded with the binary of commit f185737
 //! (`sppm run lattices/<scene>.toml --quiet`, 2 threads). A change that moves any of these
 //! numbers changes the physics or the arithmetic of a 2D run, and must say so.
 //!
@@ -14,8 +14,8 @@
 //! The uniaxial tension block (lattice and random particles) also runs on one thread: the
 //! thread count must not change results.
 //!
-//! Issue 14 made the lattices' boundary particles weigh their clipped Voronoi cells
-//! (`discretisation.surface = "voronoi_fit"`), which moves every lattice scene on purpose;
+//! Weighing the lattices' boundary particles weigh their clipped Voronoi cells
+//! (`discretisation.surface = "voronoi_fit"`) moved every lattice scene on purpose;
 //! their records were re-recorded then (benchmarks/RESULTS.md, "Surfaces"). The random
 //! scenes did not move. `GOLDEN_SOURCE_SURFACE` keeps f185737's records of three scenes,
 //! which `surface = "lattice"` still reproduces bit for bit.
@@ -52,10 +52,10 @@ const GOLDEN: &[Golden] = &[
         steps: 5171,
         particles: 3576,
     },
-    // The 3D FCC elastic prism (issue 15), recorded with 2 threads, checked on 1. Re-recorded
+    // The 3D FCC elastic prism, recorded with 2 threads, checked on 1. Re-recorded
     // when the FCC fill began to unbond particles whose bonds leave a strain undetermined
     // (58 corner and edge particles of this rotated prism; benchmarks/RESULTS.md, "Concrete
-    // in 3D"). Re-recorded again (stop 38) when the FCC cells began to be built by the random
+    // in 3D"). Re-recorded again when the FCC cells began to be built by the random
     // particles' nearest-first clipping (`voronoi3::nearest_first_cell`): the same cells cut
     // in another order, so the volumes and the peak move in the last bits (3e-13 relative).
     Golden {
@@ -72,7 +72,7 @@ const GOLDEN: &[Golden] = &[
         steps: 43841,
         particles: 5858,
     },
-    // A plate with a circular hole (cutouts), added to lattices/ in issue 14.
+    // A plate with a circular hole (cutouts).
     Golden {
         scene: "plate_with_hole",
         peak_force_n: 14853.427501365177,
@@ -87,7 +87,7 @@ const GOLDEN: &[Golden] = &[
         steps: 41947,
         particles: 823,
     },
-    // Random particles at L0 = 3.5 mm (issue 13), the same numbers on 1 and 2 threads.
+    // Random particles at L0 = 3.5 mm, the same numbers on 1 and 2 threads.
     // Re-recorded with the random particles' crack band 3.2 (was 2.8: 250.6 kN, 6.777 J).
     Golden {
         scene: "split_cylinder_random",
@@ -110,7 +110,7 @@ const GOLDEN: &[Golden] = &[
         steps: 73103,
         particles: 543,
     },
-    // Random particles (issue 13), the same numbers on 1 and 2 threads. Re-recorded when the
+    // Random particles, the same numbers on 1 and 2 threads. Re-recorded when the
     // Voronoi cells were cut about their particle in one frame (the volumes moved in their
     // last bits; peak −6e-11 relative, energy +4e-13), when damaged neighbours left the
     // criteria's neighbourhood mean (solver::concrete::Neighbourhood: peak 58.51 → 56.53 kN,
@@ -197,7 +197,7 @@ fn check_in(table: &[Golden], scene: &str, threads: &str, extra: &[&str]) {
 
 /// The source's lattice surface (`discretisation.surface = "lattice"`: full cells, bulk
 /// moduli) still gives f185737's numbers bit for bit: the records of these scenes before
-/// issue 14 made clipped Voronoi cells the default.
+/// clipped Voronoi cells became the default.
 const GOLDEN_SOURCE_SURFACE: &[Golden] = &[
     Golden {
         scene: "dogbone_B",
@@ -251,11 +251,11 @@ fn every_shipped_scene_has_a_golden_record() {
     assert_eq!(shipped, golden);
 }
 
-/// The 3D concrete scenes (issue 15) run 1–6 min each on this 2-core machine, beyond the
+/// The 3D concrete scenes run 1–6 min each on this 2-core machine, beyond the
 /// suite's budget: their records are benchmarks/RESULTS.md's ("Concrete in 3D", by
 /// `benchmarks/concrete_3d.sh`), and the tension prism's physics is asserted at 15 mm in
 /// `tests/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
-/// random particles (issue 17, 3–4 min a run): its records are RESULTS.md's ("Stop 40").
+/// random particles (3–4 min a run): its records are RESULTS.md's ("Notched tension prism").
 const LONG: &[&str] = &[
     "beam_3pb_notch02_3d",
     "beam_3pb_notch05_3d",

@@ -1,4 +1,4 @@
-//! The crate's layers run one way (issue 12): no module imports from a module above it, and
+//! The crate's layers run one way: no module imports from a module above it, and
 //! no files within a module import each other in a circle. The layers, bottom to top:
 //!
 //! 0. `aligned`, `console`, `fsio`, `limits`, `geometry`, `random_field`: plain tools;

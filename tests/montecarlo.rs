@@ -239,7 +239,7 @@ fn a_study_resumes_and_its_shards_merge_into_the_same_realisations() {
                 < 1e-12
         );
         // σN of a 0.05–0.1 m dog-bone with the mean f't = 2.415 MPa everywhere: within 10% of
-        // f't (VALIDATION.md §D; measured 4.8% and 7.2% below at this coarse spacing)
+        // f't (docs/validation.md §D; measured 4.8% and 7.2% below at this coarse spacing)
         assert!((num(&s, "deterministic_sigma_N_Pa") / 2.415e6 - 1.0).abs() < 0.1);
     }
     let json: serde_json::Value =
@@ -406,7 +406,7 @@ fn bad_shards_and_sizes_are_refused_with_the_option_named() {
     let _ = std::fs::remove_dir_all(&base);
 }
 
-/// On random particles (issue 13) the study draws the mesostructure anew per realisation:
+/// On random particles the study draws the mesostructure anew per realisation:
 /// without any random field, the realisations of one size differ (their particle sets come
 /// from their seeds), and the same study run again gives the same rows.
 #[test]

@@ -1,4 +1,4 @@
-//! VALIDATION.md §A: the patch test (homogeneous strain → interior particles carry no net
+//! docs/validation.md §A: the patch test (homogeneous strain → interior particles carry no net
 //! force, particle stress = D·ε) and Newton's third law.
 
 mod common;

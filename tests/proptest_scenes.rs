@@ -1,4 +1,4 @@
-//! Property tests of scene input (issue 4, item 4): generated scenes and mutated shipped
+//! Property tests of scene input: generated scenes and mutated shipped
 //! scenes never panic. `Scene::from_toml_str` + `prepare` return Ok or an error whose
 //! message names a key; scenes that prepare take a handful of steps and stay stable (the
 //! default reading at or below the computed limit), and some run to the end and write every
@@ -78,7 +78,7 @@ fn exercise(text: &str, full: bool) {
     for _ in 0..steps.min(20) {
         let r = sim.advance(Some(&probe)).unwrap();
         let ok = sim.check_stability(Some(r.internal_j), true);
-        // the literal force lag (A) is unstable without damping (MODEL.md §4): not checked
+        // the literal force lag (A) is unstable without damping (docs/model.md §4): not checked
         if !lagged {
             assert!(ok.is_ok(), "{ok:?}\nscene:\n{text}");
         }

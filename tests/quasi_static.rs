@@ -2,7 +2,7 @@
 //! docs/quasi_static.md): the relaxation as secant iterations, the damage state held while the
 //! positions relax and committed between equilibria, solved by the implicit secant solver on
 //! scenes with damage. Every increment of a tension block converges and the block dissipates
-//! G_f·A (VALIDATION.md §B); an elastic scene gives the relaxation's answer; an increment that
+//! G_f·A (docs/validation.md §B); an elastic scene gives the relaxation's answer; an increment that
 //! cannot converge stops the run with a message that names it.
 
 mod common;
@@ -12,10 +12,10 @@ use sppm::Scene;
 
 /// The 100 mm tension block of tests/relaxation.rs: every increment converges (the implicit
 /// secant solver) to a residual below the tolerance, the block cracks through, peaks within
-/// VALIDATION.md §B's 5% of f't·A (measured 0.963) and dissipates G_f·A within its 10%
+/// docs/validation.md §B's 5% of f't·A (measured 0.963) and dissipates G_f·A within its 10%
 /// (measured 0.986). Without the cut-back of increments in which damage jumps
 /// (`solver::secant`) the peak was 0.934 × f't·A: the cracking increment was taken whole
-/// and the force recorded before it (docs/quasi_static.md, issue 16).
+/// and the force recorded before it (docs/quasi_static.md).
 #[test]
 fn quasi_static_tension_block_converges_and_reaches_ft_and_gf() {
     let scene = tension_block(
@@ -126,7 +126,7 @@ fn unconverged_increment_stops_the_run_and_is_named() {
 /// The 100 mm tension block of the first test with indirect control (`solver.control`): the
 /// load path is the opening of a gauge between the third particle row from the bottom and
 /// the third from the top, and the load factor is solved for. Every increment converges, the
-/// gauge reaches its final opening, the block peaks within VALIDATION.md §B's 5% of f't·A and
+/// gauge reaches its final opening, the block peaks within docs/validation.md §B's 5% of f't·A and
 /// dissipates G_f·A within its 10%.
 fn controlled_tension_block(extra: &str) -> String {
     let mut text = tension_block_toml(0.1, 0.01);
@@ -147,7 +147,7 @@ method = "quasi_static"
     text
 }
 
-/// Peak within VALIDATION.md §B's 5% of f't·A and dissipated energy within its 10% of G_f·A.
+/// Peak within docs/validation.md §B's 5% of f't·A and dissipated energy within its 10% of G_f·A.
 fn assert_ft_and_gf(sm: &sppm::run::Summary, fta: f64, gfa: f64) {
     assert!(
         (sm.peak_force_n / fta - 1.0).abs() <= 0.05,

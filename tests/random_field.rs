@@ -1,4 +1,4 @@
-//! Random-field material properties (MODEL.md §12): marginal moments, correlation at several
+//! Random-field material properties (docs/model.md §12): marginal moments, correlation at several
 //! lags, seed reproducibility, independence of the lattice, white noise, parameter errors.
 //!
 //! Tolerances are 4 standard errors of the estimator from independent samples: one sample per

@@ -1,4 +1,4 @@
-//! Random-field material properties in scenes (`[[random_field]]`, MODEL.md §12,
+//! Random-field material properties in scenes (`[[random_field]]`, docs/model.md §12,
 //! src/material/properties.rs): the values reach the damage kernel and the micro-moduli, the
 //! field at a point does not depend on the lattice spacing, a seed reproduces the field, the
 //! particles' values have the target statistics, and bad tables are refused with the key.

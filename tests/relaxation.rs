@@ -1,7 +1,7 @@
 //! The adaptive dynamic-relaxation solver (`solver.method = "relaxation"`,
 //! src/solver/relaxation.rs): it reaches the static solution of an elastic plate to within
 //! its convergence tolerance, closes the energy balance, does not depend on the thread
-//! count, carries a tension block to f't·A like the explicit solver (VALIDATION.md §B), and
+//! count, carries a tension block to f't·A like the explicit solver (docs/validation.md §B), and
 //! bad keys are refused with the key, the value and what is allowed.
 
 mod common;
@@ -91,11 +91,11 @@ fn relaxation_does_not_depend_on_the_thread_count() {
 fn relaxed_tension_block_reaches_ft() {
     // After the peak 50 of the 200 increments stop at max_iterations with at most 0.58% of
     // the reactions out of balance (still 0.67% with 10× the iterations: the softening
-    // branch is where dynamic relaxation stalls, issue 16); the scene accepts 1%.
-    // On the source's lattice surface. With clipped Voronoi cells (issue 14) the same run
+    // branch is where dynamic relaxation stalls); the scene accepts 1%.
+    // On the source's lattice surface. With clipped Voronoi cells the same run
     // leaves 71 of 200 increments unconverged above 1% and dissipates 1.61 × G_f·A (peak
-    // 0.956 × f't·A): the relaxation does not converge on this softening branch, which is
-    // issue 16's to fix (benchmarks/RESULTS.md, "Surfaces").
+    // 0.956 × f't·A): the relaxation does not converge on this softening branch, which the
+    // quasi-static solver addresses (benchmarks/RESULTS.md, "Surfaces").
     let scene = tension_block(
         0.1,
         0.01,
@@ -130,7 +130,7 @@ fn relaxed_tension_block_reaches_ft() {
     // The 100 mm block separates without snap-back, so the relaxation follows the softening
     // branch and the energy booked as dissipated (external work less elastic, kinetic and
     // damper energy, with the predictor's work booked exactly) is G_f per unit crack area,
-    // within the 10% of VALIDATION.md §B. Measured 1.035 G_f·A.
+    // within the 10% of docs/validation.md §B. Measured 1.035 G_f·A.
     assert!(
         (sm.dissipated_energy_j / gfa - 1.0).abs() <= 0.10,
         "dissipated {} J against G_f·A = {gfa} J",

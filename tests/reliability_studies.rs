@@ -1,4 +1,4 @@
-//! Reliability of `sppm study` (issue 11, docs/reliability.md "Studies"): counts checked
+//! Reliability of `sppm study` (docs/reliability.md "Studies"): counts checked
 //! against the memory before anything is made, a Monte Carlo study whose runs all fail is not
 //! a success, a merge names what is missing, a folder whose rows have no inputs record is not
 //! adopted, and one study at a time per folder.

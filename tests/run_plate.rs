@@ -1,7 +1,7 @@
 //! A damped, displacement-controlled run of a plate in tension through the whole pipeline:
 //! the energy balance closes, the run is quasi-static and ends at the static solution, the
 //! result does not depend on the thread count, and both readings of the force lag agree
-//! when damped (MODEL.md §4).
+//! when damped (docs/model.md §4).
 
 mod common;
 use common::*;

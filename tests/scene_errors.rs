@@ -1,5 +1,5 @@
 //! Every scene-validation path: a bad scene stops before any work with one message naming
-//! the key, the value and what is allowed (ARCHITECTURE.md, "Interfaces").
+//! the key, the value and what is allowed (docs/architecture.md, "Interfaces").
 
 mod common;
 use common::says;

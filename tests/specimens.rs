@@ -1,4 +1,4 @@
-//! The shipped concrete specimens (VALIDATION.md §C, §D): the split cylinder reaches the
+//! The shipped concrete specimens (docs/validation.md §C, §D): the split cylinder reaches the
 //! peak of (5.6) for its strip width and cracks along the loaded diameter; dog-bone B
 //! reaches the engineering peak and cracks across its narrow section; both, symmetric with a
 //! symmetric lattice, crack symmetrically.
@@ -88,7 +88,7 @@ fn split_cylinder_peak_crack_and_symmetry() {
     assert!(worst <= 0.01, "asymmetric crack pattern: {worst}");
 }
 
-/// VALIDATION.md §D, dog-bone B (D = 100 mm, L0 = 4 mm): the peak within 10% of the
+/// docs/validation.md §D, dog-bone B (D = 100 mm, L0 = 4 mm): the peak within 10% of the
 /// engineering value f't·0.6·D·t = 14.49 kN, quasi-static to the peak, a crack across the
 /// narrow section (at least one row of fully cracked particles spanning the width there),
 /// and symmetric about the axis.

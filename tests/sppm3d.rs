@@ -1,4 +1,4 @@
-//! Random particles in 3D (SPPM, issue 17): the elastic block against (E, ν), the scene's
+//! Random particles in 3D (SPPM): the elastic block against (E, ν), the scene's
 //! pipeline and its bad input.
 
 mod common;
@@ -53,7 +53,7 @@ fn print_random_block_moduli() {
     }
 }
 
-/// Acceptance (issue 17): a 16 × 16 × 32 mm block of random particles at L0 = 1 mm, its
+/// Acceptance: a 16 × 16 × 32 mm block of random particles at L0 = 1 mm, its
 /// moduli fitted by the pipeline (the calibrated target of `model::sppm_calibration`), pulled
 /// along its length with the sides free, shows the scene's E = 30 GPa and ν = 0.2 within 2%
 /// as the mean over 5 particle sets (the table was measured at W/L0 = 20 over other sets;
@@ -229,8 +229,8 @@ fn static_force(sc: &sppm::Scene) -> f64 {
     -top.iter().map(|&i| f[i].z).sum::<f64>()
 }
 
-/// The quasi-static solver on random 3D particles (36 bond slots, more than the 32 its
-/// branch bits held until stop 40, where it panicked): the concrete box pulled to half its
+/// The quasi-static solver on random 3D particles (36 bond slots: its branch bits were
+/// once held in 32 bits, and it panicked): the concrete box pulled to half its
 /// tensile strength stays undamaged, every increment converges, and the force is the static
 /// solve's within 1e-3 (the solver's tolerance is 1e-5 of the reactions).
 #[test]
@@ -299,7 +299,7 @@ fn study_rows(path: &std::path::Path) -> Vec<std::collections::HashMap<String, S
     common::csv_rows(path)
 }
 
-/// Random 3D scenes in the studies (issue 17, item 5). Objectivity: `--axis x` turns each
+/// Random 3D scenes in the studies. Objectivity: `--axis x` turns each
 /// realisation's particle set about x (the prism's loading axis z against the particles),
 /// realisation k has the same seed at every angle, and a turned set is another set (its
 /// peak differs). Monte Carlo: each realisation draws its own particle set (different seeds,

@@ -1,8 +1,8 @@
-//! SPPM (random particles, issue 13): the Table 1 tension block
+//! SPPM (random particles): the Table 1 tension block
 //! (`lattices/uniaxial_tension_random.toml`, L0 = 7 mm, crack band 3.2) over ten particle
 //! sets, and the split cylinder.
 //!
-//! Tension block, the issue's acceptance on the means of seeds 1–10: the peak within ±5% of
+//! Tension block, the acceptance on the means of seeds 1–10: the peak within ±5% of
 //! f't·A and the dissipated energy within ±10% of G_f·A (measured over the 200 runs of the
 //! rotation study: 0.994 and 1.017; seeds 1–10: 0.992 and 0.960). Every set's crack runs
 //! across the block: the cracked particles (w_t ≥ 0.99) span its width. Perpendicular to the

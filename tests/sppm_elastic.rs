@@ -1,4 +1,4 @@
-//! SPPM (random particles, issue 13): E and ν of a plate in uniaxial tension.
+//! SPPM (random particles): E and ν of a plate in uniaxial tension.
 mod common;
 use common::*;
 use sppm::run::prepare::{prepare_model_random, prepare_model_random_uncalibrated};
@@ -34,7 +34,7 @@ fn mean_e_nu(spacing: f64, nu: f64, plane: &str) -> (f64, f64) {
     (e, n)
 }
 
-/// Issue 13 acceptance: E and ν of a plate of random particles within 2% of the input for
+/// Acceptance: E and ν of a plate of random particles within 2% of the input for
 /// ν = 0.1, 0.2, 0.3 (plane stress; plane strain at ν = 0.2), means over 10 particle sets, at
 /// W/L0 = 80: another size than the calibration's (W/L0 = 100).
 #[test]

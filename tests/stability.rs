@@ -1,4 +1,4 @@
-//! Numerical stability and robustness (issue 4, item 4; MODEL.md §5, VALIDATION.md §A): time
+//! Numerical stability and robustness (docs/model.md §5, docs/validation.md §A): time
 //! steps of 0.5×, 0.9×, 1.1× and 2× the computed limit, blow-up detection at library level,
 //! and extreme but valid parameters (ν = 0, ν = 0.45 in plane strain, a 1000× contrast in E
 //! between neighbouring particles).
@@ -24,7 +24,7 @@ fn plate(overrides: &[&str]) -> Scene {
 }
 
 /// The Table 1 tension block (150 × 300 mm) at L0 = 12.5 mm, loaded to 1.5·COD_c.
-/// The tension block on the source's lattice surface: with clipped Voronoi cells (issue 14)
+/// The tension block on the source's lattice surface: with clipped Voronoi cells
 /// its peak depends on Δt ten times more (0.9× against 0.5× the limit: −4.9e-3 with
 /// `voronoi_fit`, +2.6e-3 with `voronoi`, −4.0e-4 on the source's surface; 0.7× lies
 /// between), which is recorded in benchmarks/RESULTS.md ("Surfaces") and left open there;
@@ -247,7 +247,7 @@ fn to_3d(e_plane: f64, nu_plane: f64) -> (f64, f64) {
     (e_plane * (1.0 - nu * nu), nu)
 }
 
-/// E and ν (3D values) of the static plate test of VALIDATION.md §A (100 × 200 mm, tension).
+/// E and ν (3D values) of the static plate test of docs/validation.md §A (100 × 200 mm, tension).
 fn plate_e_nu(plane: &str, nu: f64, l0: f64) -> (f64, f64) {
     let (w, h, t) = (0.1, 0.2, 0.05);
     let m = prepare_model(&scene(&plate_toml(w, h, l0, 0.0, plane, false, nu))).unwrap();
@@ -262,7 +262,7 @@ fn plate_e_nu(plane: &str, nu: f64, l0: f64) -> (f64, f64) {
 #[test]
 fn extreme_poisson_ratios_recover_e_and_nu_and_run_stably() {
     // ν = 0 in plane stress and strain, and ν = 0.45 in plane strain (ν' = 0.82, b > 0 and
-    // large), at W/L0 = 80: E and ν within the 1% of VALIDATION.md §A (ν = 0: within 0.002,
+    // large), at W/L0 = 80: E and ν within the 1% of docs/validation.md §A (ν = 0: within 0.002,
     // 1% of the default 0.2). Measured: ν = 0: E −0.07%, ν 1e-5; ν = 0.45: E −0.68%, ν +0.09%.
     for (plane, nu) in [("stress", 0.0), ("strain", 0.0), ("strain", 0.45)] {
         let (e, n) = plate_e_nu(plane, nu, 0.00125);

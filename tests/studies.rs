@@ -1,7 +1,7 @@
 //! `sppm study objectivity|convergence` as a user meets it: one CSV row per run written as the
 //! run finishes, the overlay and convergence plots, the per-run outputs, resuming an
 //! interrupted study, clear errors for bad arguments, and the objectivity of the tension block
-//! against VALIDATION.md §B.
+//! against docs/validation.md §B.
 
 mod common;
 use common::sppm;
@@ -369,7 +369,7 @@ fn a_60_degree_turn_gives_the_same_peak() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
-/// VALIDATION.md §B: the tension block's peak at lattice rotations 0° and 30° agrees within
+/// docs/validation.md §B: the tension block's peak at lattice rotations 0° and 30° agrees within
 /// 3%, and the crack crosses the block perpendicular to the load. The shipped block is
 /// shortened to 150 × 150 mm and loaded over 15 fundamental periods (instead of 60) to run in
 /// seconds, at L0 = 5 mm, 30 particles across, where benchmarks/RESULTS.md found the shipped
@@ -415,7 +415,7 @@ fn tension_block_peak_is_objective_at_0_and_30_degrees() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
-/// The objectivity study on random particles (issue 13): "offset" k is a particle set of its
+/// The objectivity study on random particles: "offset" k is a particle set of its
 /// own seed (k = 0: the scene's), the same sets at every angle, each turned by the angle; the
 /// report gives per angle the mean and CoV of the peak and energy.
 #[test]

@@ -1,4 +1,4 @@
-//! Surfaces (issue "Surfaces"): the lattice's boundary particles weighted by their clipped
+//! Surfaces: the lattice's boundary particles weighted by their clipped
 //! Voronoi cells (`discretisation.surface`), and the recovered stress at free surfaces.
 //!
 //! Measured tables (all methods, more depths, rotations and offsets):
@@ -99,7 +99,7 @@ fn every_shipped_body_carries_its_mass_at_any_rotation_and_offset() {
     assert!(checked >= 7 * 12, "{checked} bodies checked");
 }
 
-/// VALIDATION.md §A on plates of 20 and 40 spacings: E and ν within 1% at rotations 0, 15
+/// docs/validation.md §A on plates of 20 and 40 spacings: E and ν within 1% at rotations 0, 15
 /// and 30° (faces across the lattice rows, oblique, along them).
 #[test]
 fn plate_in_tension_modulus_within_one_percent() {

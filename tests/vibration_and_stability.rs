@@ -1,7 +1,7 @@
-//! VALIDATION.md §A, undamped free vibration of a bar: fundamental period against the
+//! docs/validation.md §A, undamped free vibration of a bar: fundamental period against the
 //! analytic value, energy drift over 100 periods for both readings of the force lag
-//! (MODEL.md §4), and the computed stable time step against the measured instability
-//! threshold (MODEL.md §5).
+//! (docs/model.md §4), and the computed stable time step against the measured instability
+//! threshold (docs/model.md §5).
 
 mod common;
 use common::scene;
@@ -195,7 +195,7 @@ fn undamped_energy_drift_over_100_periods() {
     assert!(spread < 1e-2);
 
     // Reading (A), the literal lag: each mode grows by about 1 + (ω·Δt)²/2 per step
-    // (MODEL.md §4); undamped it blows up and the guard stops it, naming step and particle.
+    // (docs/model.md §4); undamped it blows up and the guard stops it, naming step and particle.
     let (e, failure, e0) = energy_history(true, 100.0);
     let msg = failure.expect("the lagged reading must go unstable without damping");
     println!(

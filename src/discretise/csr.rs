@@ -1,13 +1,13 @@
 //! Bonds in compressed sparse rows (CSR): a varying number of neighbours per particle
-//! (MODEL.md §1).
+//! (docs/model.md §1).
 //!
 //! The lattices give every particle K fixed slots ([`Particles`]); SPPM's random particles
 //! have as many bonds as the "either end lists the other" rule of the k nearest gives them
-//! (MODEL.md §1, (3.50)), so a fixed K either wastes slots or cannot hold them. Here the
+//! (docs/model.md §1, (3.50)), so a fixed K either wastes slots or cannot hold them. Here the
 //! bonds of particle i are the flat entries `offsets[i]..offsets[i + 1]`, each directed bond
 //! "ij" seen by i holding j, the position of its reverse "ji" (seen by j) and 1/L0. The
 //! neighbour list is built once in the reference configuration and never changes
-//! (MODEL.md §1).
+//! (docs/model.md §1).
 //!
 //! Invariants, established by the constructors and relied on by the CSR step kernel
 //! (`solver::csr_kernel`): offsets start at 0 and never decrease, the last is the number of
@@ -19,7 +19,7 @@ use super::{Particles, NONE};
 use crate::aligned::{copied, Aligned};
 use nalgebra::SVector;
 
-/// The bonds of a body, two directed entries per undirected bond (MODEL.md §1: particle i
+/// The bonds of a body, two directed entries per undirected bond (docs/model.md §1: particle i
 /// sees bond "ij", particle j sees "ji"), in arrays that start on cache lines and ask for
 /// huge pages ([`crate::aligned`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -30,7 +30,7 @@ pub struct Csr {
     neighbours: Aligned<u32>,
     /// Per directed bond ij: the flat position of bond ji.
     reverse: Aligned<u32>,
-    /// Per directed bond: 1/L0, with L0 the reference length (MODEL.md §2, (3.10)).
+    /// Per directed bond: 1/L0, with L0 the reference length (docs/model.md §2, (3.10)).
     inv_l0: Aligned<f64>,
 }
 
@@ -112,7 +112,7 @@ impl Csr {
 
     /// The bonds of `x0.len()` particles at reference positions `x0` given as undirected
     /// pairs (i, j), as SPPM's neighbour search produces them (a bond wherever either end
-    /// lists the other among its k nearest, MODEL.md §1). A pair may appear in either order
+    /// lists the other among its k nearest, docs/model.md §1). A pair may appear in either order
     /// and more than once; it makes one bond. Each particle's bonds are ordered by
     /// neighbour index; L0 = |x0_j − x0_i| is computed once per bond, so both directions
     /// carry the same 1/L0 bit for bit.

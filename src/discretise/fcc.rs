@@ -1,4 +1,4 @@
-//! The 3D face-centred cubic lattice of SPLM (MODEL.md §1, §3): nearest spacing L0, any
+//! The 3D face-centred cubic lattice of SPLM (docs/model.md §1, §3): nearest spacing L0, any
 //! rotation (three angles) and offset, clipped to the body. Each particle has 18 slots: the
 //! 12 nearest neighbours at L0 (slots 0..12) and the 6 second neighbours at √2·L0 (slots
 //! 12..18, [`SECOND`]); the direction of slot k^1 is the opposite of slot k's, so the reverse
@@ -168,7 +168,7 @@ impl FccLattice {
 }
 
 /// Remove every bond of a particle whose bonds do not determine a strain (the least-squares
-/// strain of MODEL.md §7 needs six independent bond directions: fewer than six bonds, or all
+/// strain of docs/model.md §7 needs six independent bond directions: fewer than six bonds, or all
 /// in one plane — a corner or edge particle of a rotated lattice), repeatedly, since its
 /// neighbours may lose theirs in turn. With bonds in a plane a particle moves across them
 /// without resistance (a zero-stiffness mode: T1 and the static solves fail on it); with

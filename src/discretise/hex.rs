@@ -1,4 +1,4 @@
-//! The 2D hexagonal close-packed lattice of SPLM (MODEL.md §1): spacing L0, any rotation
+//! The 2D hexagonal close-packed lattice of SPLM (docs/model.md §1): spacing L0, any rotation
 //! and offset, clipped to the body. Each particle has six slots, one per lattice
 //! direction at 0°, 60°, …, 300° (before rotation); the reverse of slot k is (k+3) mod 6.
 //! ΔV = (√3/2)·t·L0².

@@ -1,4 +1,4 @@
-//! Discretisations fill a body (MODEL.md §1): particles with reference positions, volumes,
+//! Discretisations fill a body (docs/model.md §1): particles with reference positions, volumes,
 //! a horizon and a length scale each, their micro-moduli, and bonds with their own reference
 //! length; and named groups of particles.
 //!
@@ -37,13 +37,13 @@ pub struct Particles<const D: usize, const K: usize> {
     pub reverse: Vec<[u8; K]>,
     /// Reference bond length per slot (m); 0 where empty.
     pub l0: Vec<[f64; K]>,
-    /// Horizon r_i of each particle (m): the reach of its bonds (MODEL.md §1; L0 for the
+    /// Horizon r_i of each particle (m): the reach of its bonds (docs/model.md §1; L0 for the
     /// hexagonal lattice, √2·L0 for FCC, the distance to the k-th nearest particle for SPPM).
     pub horizon: Vec<f64>,
     /// Each particle's own length scale L0,i (m), its nearest-neighbour spacing: the particle
     /// frequency ω_i (section 4.3, (3.55)) and the crack band (4.13) use it.
     pub length: Vec<f64>,
-    /// Micro-modulus a_i of each particle (N; MODEL.md §3), filled for the discretisation
+    /// Micro-modulus a_i of each particle (N; docs/model.md §3), filled for the discretisation
     /// by `run::prepare` (0 until then).
     pub a: Vec<f64>,
     /// Micro-modulus b_i (N).
@@ -174,7 +174,7 @@ impl<const D: usize, const K: usize> Particles<D, K> {
 /// Counted field by field (`Particles`, `solver::mechanics::Mechanics`,
 /// `solver::kernel::State`): x0, x, x_next, v, v_next, force, force_prev: 7·D f64; volume,
 /// horizon, length and the body's a, b, c; the kernel's a, b, mass, inv_mass, c_in, c_ex;
-/// b·θ and the damper work: 14 f64, and in 3D the kernel's second-neighbour c (MODEL.md §3):
+/// b·θ and the damper work: 14 f64, and in 3D the kernel's second-neighbour c (docs/model.md §3):
 /// 15; per slot the neighbour index twice (the body's and the kernel's, u32), reverse (u8),
 /// l0 and 1/l0 (f64): 25 bytes; the kernel's slot end (u8), group bookkeeping and outputs:
 /// ~64 bytes; in 3D also the dilatation weight per slot (f64; the FCC lattice runs with the

@@ -1,4 +1,4 @@
-//! Random particles in 2D (SPPM; 002 chapter 3, MODEL.md §1): particles on the body's outline
+//! Random particles in 2D (SPPM; Nikravesh Kazeroni (2017) chapter 3, docs/model.md §1): particles on the body's outline
 //! at the spacing, the interior filled by random sequential Poisson-disc sampling with a
 //! minimum distance, each particle weighted by its Voronoi cell clipped to the body
 //! ([`super::voronoi`]) and bonded to its k = 6 nearest particles (3.50).

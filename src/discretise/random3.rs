@@ -1,4 +1,4 @@
-//! Random particles in 3D (SPPM; 002 §3.2–3.5, MODEL.md §1): particles on the body's surface
+//! Random particles in 3D (SPPM; Nikravesh Kazeroni (2017) §3.2–3.5, docs/model.md §1): particles on the body's surface
 //! first, the interior filled by random sequential Poisson-disc sampling with a minimum
 //! distance, each particle weighted by its Voronoi cell clipped to the body
 //! ([`voronoi3::clipped_volumes`]) and bonded to its 18 nearest particles (3.50).
@@ -473,7 +473,7 @@ mod tests {
     }
 
     /// The clipped Voronoi cells sum to the body's volume (1e-9 relative) on a box, a
-    /// cylinder, the dog-bone prism and a prism with a slit (issue 17).
+    /// cylinder, the dog-bone prism and a prism with a slit.
     #[test]
     fn cells_sum_to_the_body_volume() {
         for s in shapes() {

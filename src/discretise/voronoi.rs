@@ -1,4 +1,4 @@
-//! Voronoi cells of a 2D particle set, clipped to the body (002 (3.52)–(3.53); MODEL.md §1:
+//! Voronoi cells of a 2D particle set, clipped to the body (Nikravesh Kazeroni 2017, (3.52)–(3.53); docs/model.md §1:
 //! "Voronoi cell of the particle, clipped to the body").
 //!
 //! The Delaunay triangulation (`spade`) gives each particle its Voronoi neighbours; the cell

@@ -1,4 +1,4 @@
-//! Voronoi cells of particles in a 3D body, clipped to the body (issue "Surfaces" carried to
+//! Voronoi cells of particles in a 3D body, clipped to the body (the 2D treatment of docs/surfaces.md carried to
 //! 3D): the volume ΔV_i of a boundary particle of the FCC lattice is its cell clipped to the
 //! body, so the particles carry the body's volume at any rotation and offset.
 //!
@@ -151,7 +151,7 @@ pub fn fcc_clipped_volumes(p: &Particles<3, SLOTS>, shape: &Shape3) -> Vec<f64> 
 }
 
 /// The Voronoi cell volumes of any particle set in `shape` (random particles, SPPM in 3D;
-/// 002 (3.53) without its sphere approximation), each cell clipped to the body: exactly by
+/// Nikravesh Kazeroni (2017) (3.53) without its sphere approximation), each cell clipped to the body: exactly by
 /// the planes of a box; for a prism or a cylinder by slicing along the axis
 /// ([`volume_in_section`]). The cells tile the body, so the volumes sum to its volume (the
 /// tests: within 1e-9 on a box, a cylinder and the dog-bone prism). `spacing`: the mean

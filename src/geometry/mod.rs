@@ -38,7 +38,7 @@ pub enum Shape2 {
     Polygon { vertices: Vec<Vector2<f64>> },
     /// Disc (a cylinder's cross-section).
     Disc { centre: Vector2<f64>, radius: f64 },
-    /// The van Vliet & van Mier dog-bone of size `d` (VALIDATION.md §D): height 1.5·D, width
+    /// The van Vliet & van Mier dog-bone of size `d` (docs/validation.md §D): height 1.5·D, width
     /// D at the ends narrowing to 0.6·D at mid-height along two arcs of radius 0.725·D.
     /// Spans x ∈ [−D/2, D/2], y ∈ [0, 1.5·D].
     DogBone { size: f64 },

@@ -1,4 +1,4 @@
-//! 3D specimen bodies (issue "3D"): a box, a cylinder about any axis, and any 2D shape
+//! 3D specimen bodies: a box, a cylinder about any axis, and any 2D shape
 //! extruded through a thickness along z (so the dog-bone, the notched beam and every body
 //! with cutouts come as prisms). They answer what the FCC lattice asks of a body: a bounding
 //! box, a point test with a tolerance, whether a bond stays in the body, and the volume.

@@ -1,4 +1,4 @@
-//! Elastic constants and the values derived from them for the dampers (MODEL.md §5).
+//! Elastic constants and the values derived from them for the dampers (docs/model.md §5).
 pub mod properties;
 
 /// Bulk modulus κ = E/(3(1−2ν)) as the source uses it for the wave speed (3.57).

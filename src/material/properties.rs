@@ -1,10 +1,10 @@
-//! Per-particle material properties from a scene's `[[random_field]]` tables (MODEL.md §12).
+//! Per-particle material properties from a scene's `[[random_field]]` tables (docs/model.md §12).
 //!
 //! Each table draws one property (f't, E, G_f or f'c) at every particle as
 //! `marginal.map(g(x0))`, g the standard Gaussian field of [`GaussianField`] generated over the
 //! body's bounding box (not the particles' box, so that every lattice filling the body samples
 //! the same field). The mean defaults to the property's deterministic value (scene, preset or
-//! correlation, MODEL.md §11).
+//! correlation, docs/model.md §11).
 //!
 //! **Seeds.** A table's `seed` if given, else `splitmix64(scene seed ^ tag(property))`, so that
 //! the properties of one scene are independent fields and one scene seed fixes them all.

@@ -1,4 +1,4 @@
-//! Two-spring damage (MODEL.md §6, (3.36), (3.37)) and the concrete laws that drive it:
+//! Two-spring damage (docs/model.md §6, (3.36), (3.37)) and the concrete laws that drive it:
 //! tensile initiation and bilinear softening (§8, (4.12)–(4.14)), compressive damage
 //! (§9, (4.16), (4.17)).
 
@@ -33,7 +33,7 @@ pub struct ConcreteLaw {
     pub crack_band: f64,
 }
 
-/// The values of the law that a random field varies per particle (MODEL.md §12; see
+/// The values of the law that a random field varies per particle (docs/model.md §12; see
 /// `material::properties`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LocalProperties {
@@ -48,7 +48,7 @@ pub struct LocalProperties {
 }
 
 impl ConcreteLaw {
-    /// The Table 1 concrete of 002 in plane stress (E = 30 GPa, ν = 0.2, f'c = 27.58 MPa,
+    /// The Table 1 concrete of Nikravesh Kazeroni (2017) in plane stress (E = 30 GPa, ν = 0.2, f'c = 27.58 MPa,
     /// f't = 2.6168 MPa, G_f = 81.4 N/m, α = 0.1, γ = 0.25, Rankine initiation, crack band
     /// 2.8·L0) with tensile damage, and with compressive damage and plasticity where `full`:
     /// the law `sppm bench` times.
@@ -169,7 +169,7 @@ pub fn softening_stress(law: &ConcreteLaw, cod: f64) -> f64 {
     }
 }
 
-/// Whether tensile damage starts (MODEL.md §8) for principal stresses p1 ≥ p2 ≥ p3
+/// Whether tensile damage starts (docs/model.md §8) for principal stresses p1 ≥ p2 ≥ p3
 /// (σ_PI = max(p1, 0) (4.12), σ_PIII = p3).
 #[inline]
 pub fn initiates(law: &ConcreteLaw, p1: f64, p3: f64) -> bool {

@@ -1,4 +1,4 @@
-//! Damage laws behind a trait (MODEL.md §6): what a material's damage and plasticity decide,
+//! Damage laws behind a trait (docs/model.md §6): what a material's damage and plasticity decide,
 //! apart from the kernel that moves the particles (`solver::concrete`).
 //!
 //! The kernel owns the kinematics: for each particle it computes, bond by bond, the total
@@ -9,8 +9,8 @@
 //!
 //! # Adding a damage law
 //!
-//! A new law (say the bond-based bilinear softening of seed 000, or the failure criteria of
-//! seed 001) implements [`DamageLaw`] and nothing else; neither the kernel nor the pipeline
+//! A new law (say the bond-based bilinear softening of Hobbs (2021), or the failure criteria of
+//! Ness (2019)) implements [`DamageLaw`] and nothing else; neither the kernel nor the pipeline
 //! changes:
 //!
 //! 1. `type State`: what one particle remembers (e.g. the largest stretch reached), `Copy`
@@ -85,7 +85,7 @@ where
     pub undamaged: bool,
     /// Micro-modulus a_i.
     pub a: f64,
-    /// The FCC second-neighbour modulus c_i and its first slot (MODEL.md §3 erratum): slots
+    /// The FCC second-neighbour modulus c_i and its first slot (docs/model.md §3 erratum): slots
     /// `first..K` have the bond modulus a_i + c_i; `None` without second neighbours.
     pub second: Option<(f64, usize)>,
     /// The undamaged dilatation term b_i·Σ S_e (for the force states of plastic flow).
@@ -110,7 +110,7 @@ where
     }
 
     /// The particle's own bond modulus in slot k: a_i, or a_i + c_i in a second-neighbour
-    /// slot (MODEL.md §3 erratum), for its force states (3.8).
+    /// slot (docs/model.md §3 erratum), for its force states (3.8).
     #[inline(always)]
     pub fn modulus(&self, k: usize) -> f64 {
         crate::model::force_state::slot_modulus(self.a, self.second, k)

@@ -1,4 +1,4 @@
-//! The SPLM force law, written once (MODEL.md §3–4, §6; (3.7), (3.8), (3.36)).
+//! The SPLM force law, written once (docs/model.md §3–4, §6; (3.7), (3.8), (3.36)).
 //!
 //! Every caller computes bond forces, force states, the dilatation term and the stored
 //! energy through these functions: the scalar step kernels (`solver::kernel`,
@@ -31,7 +31,7 @@ pub fn dilatation_term(b: f64, stretch_sum: f64) -> f64 {
 }
 
 /// Particle i's own bond modulus in slot k: a_i, or a_i + c_i in an FCC second-neighbour
-/// slot (MODEL.md §3 erratum); `second` is (c_i, the first second-neighbour slot), `None`
+/// slot (docs/model.md §3 erratum); `second` is (c_i, the first second-neighbour slot), `None`
 /// without second neighbours.
 #[inline(always)]
 pub fn slot_modulus(a: f64, second: Option<(f64, usize)>, k: usize) -> f64 {

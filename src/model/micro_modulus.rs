@@ -1,4 +1,4 @@
-//! Micro-elastic constants a, b (and c in 3D) of the force state (MODEL.md §3; (4.5), (4.6),
+//! Micro-elastic constants a, b (and c in 3D) of the force state (docs/model.md §3; (4.5), (4.6),
 //! (4.8)) and the per-particle least-squares fit D ≈ M_i·K_i·N_i (3.20) used for SPPM
 //! particles and for the "surface correction" of lattice particles with missing bonds.
 //!
@@ -10,7 +10,7 @@
 //!
 //! The 2D functions here are wrappers over `model::dimension`, which gives the same in 3D
 //! (Voigt [xx, yy, zz, yz, xz, xy], v = [nx², ny², nz², ny·nz, nx·nz, nx·ny]). For the FCC
-//! lattice, F_s,ij = (a + c·[j ∈ N_II])·S_ij + b·Σ_m S_im (MODEL.md §3 with its erratum), so
+//! lattice, F_s,ij = (a + c·[j ∈ N_II])·S_ij + b·Σ_m S_im (docs/model.md §3 with its erratum), so
 //! D_i = a·A + b·B + c·C with C = Σ_{j ∈ N_II} w_j v_j v_jᵀ ([`fcc_basis`], [`fit_fcc`]).
 
 use super::dimension::{least_squares, Dim, Dimension};
@@ -57,7 +57,7 @@ pub fn fit(bonds: &[(Vector2<f64>, f64)], volume: f64, d: &Matrix3<f64>) -> Opti
 }
 
 /// Micro-elastic constants of an FCC particle (N; per unit stretch): F_s,ij =
-/// (a + c·[j ∈ N_II])·S_ij + b·Σ_m S_im (MODEL.md §3 with its erratum: c acts on the
+/// (a + c·[j ∈ N_II])·S_ij + b·Σ_m S_im (docs/model.md §3 with its erratum: c acts on the
 /// second-neighbour bond's own stretch, so second neighbours have modulus a + c).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FccModuli {
@@ -193,7 +193,7 @@ mod tests {
 
     #[test]
     fn closed_form_constants_reproduce_isotropic_elasticity() {
-        // MODEL.md §3: D = M·K·N exactly for a bulk hexagonal particle.
+        // docs/model.md §3: D = M·K·N exactly for a bulk hexagonal particle.
         for plane in [Plane::Stress, Plane::Strain] {
             for nu in [0.0, 0.2, 1.0 / 3.0, 0.45] {
                 let (e, l0, t) = (30e9, 0.01, 0.1);

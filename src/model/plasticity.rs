@@ -1,4 +1,4 @@
-//! Plasticity of a particle (MODEL.md §9; (3.38)–(3.48), (4.15)).
+//! Plasticity of a particle (docs/model.md §9; (3.38)–(3.48), (4.15)).
 //!
 //! **Erratum applied.** (3.43) divides half the norm of the deviatoric stress by
 //! F_eff^(2/3), which is dimensionally inconsistent; the yield ratio is the von Mises form

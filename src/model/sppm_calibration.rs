@@ -1,4 +1,4 @@
-//! Elastic calibration of random particles (SPPM, MODEL.md §3 and §13).
+//! Elastic calibration of random particles (SPPM, docs/model.md §3 and §13).
 //!
 //! **Decision (measured).** Each random particle's micro-moduli are the least-squares
 //! solution of D = M_i·K_i·N_i (3.20) for its own bonds. Two parameters (a_i, b_i) cannot make
@@ -18,7 +18,7 @@
 //! Plane strain uses the same in-plane map (the 2D model sees only in-plane constants:
 //! E' = E/(1−ν²), ν' = ν/(1−ν)).
 //!
-//! **In 3D** (issue 17) the same holds: 18-nearest particles fitted to (E, ν) with the
+//! **In 3D** the same holds: 18-nearest particles fitted to (E, ν) with the
 //! isotropic 6×6 D give a block about 15% too soft with ν about 0.02 high (`min_distance`
 //! 0.7), the same for every particle set (spread over seeds 0.4% in E, 0.001 in ν at
 //! W/L0 = 20; 0.851 at W/L0 = 16 against 0.854 at 24). [`fit_target_3d`] reads the 3D table:

@@ -1,4 +1,4 @@
-//! Strain at a particle (MODEL.md §7) from its bond stretches.
+//! Strain at a particle (docs/model.md §7) from its bond stretches.
 //!
 //! **Decision (refines §7).** The strain is the one that best fits the particle's own bond
 //! stretches in the least-squares sense, ε_i = N_i⁺·S_T,i (N_i's rows v = [nx², ny², nx·ny],

@@ -1,4 +1,4 @@
-//! Particle stress (MODEL.md §7, (3.18)): σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(n_ij ⊗ n_ij),
+//! Particle stress (docs/model.md §7, (3.18)): σ_i = (1/(2ΔV_i))·Σ_j L0,ij·F_s,ij·(n_ij ⊗ n_ij),
 //! in any dimension D (2 by default).
 
 use nalgebra::{SMatrix, SVector};

@@ -1,4 +1,4 @@
-//! Bond stretch (MODEL.md §2).
+//! Bond stretch (docs/model.md §2).
 
 /// Total stretch S_T = (L − L0)/L0 (3.10), written with 1/L0 precomputed.
 #[inline(always)]

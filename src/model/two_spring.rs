@@ -1,4 +1,4 @@
-//! The two-spring concrete law (MODEL.md §6–9) as a [`DamageLaw`]: tensile damage by
+//! The two-spring concrete law (docs/model.md §6–9) as a [`DamageLaw`]: tensile damage by
 //! Rankine or interaction initiation and bilinear softening over a crack band, compressive
 //! damage, and plasticity with linear hardening.
 //!
@@ -27,7 +27,7 @@ where
     pub law: ConcreteLaw,
     /// Elasticity matrix D of the law (Voigt, engineering shear).
     pub d: <Dim<D> as Dimension<D>>::Stiffness,
-    /// Each particle's own values (random fields, MODEL.md §12); `None`: the law's values
+    /// Each particle's own values (random fields, docs/model.md §12); `None`: the law's values
     /// everywhere.
     pub local: Option<Vec<LocalProperties>>,
 }
@@ -52,7 +52,7 @@ where
     type State = ParticleDamage;
 
     /// The tension kernel unless the law has compressive damage or plasticity
-    /// (ARCHITECTURE.md, "skip what the scene does not need").
+    /// (docs/architecture.md, "skip what the scene does not need").
     fn kernel(&self) -> Kernel {
         if self.law.compressive_damage || self.law.plasticity {
             Kernel::Full

@@ -1,4 +1,4 @@
-//! Reports of a run (ARCHITECTURE.md, "Interfaces"): summary.json, force_displacement.csv,
+//! Reports of a run (docs/architecture.md, "Interfaces"): summary.json, force_displacement.csv,
 //! increments.csv (relaxation and quasi-static runs), particles.csv,
 //! force_displacement.svg, crack_map.svg (scenes with damage), random_field_<property>.svg (each
 //! random field, with the crack on top), particle_map.svg and particles.vtk in the run's folder.

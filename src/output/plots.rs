@@ -322,7 +322,7 @@ pub fn particle_map(o: &Outcome, field: Field, scale: f64, path: &Path) -> anyho
     )
 }
 
-/// random_field_<property>.svg: a random field's values (MODEL.md §12) at every particle, at
+/// random_field_<property>.svg: a random field's values (docs/model.md §12) at every particle, at
 /// x0 + scale·u, with the cracked particles (w_t ≥ 0.99) drawn as black dots on top, so the
 /// crack can be read against the field.
 pub fn field_map(o: &Outcome, k: usize, scale: f64, path: &Path) -> anyhow::Result<()> {

@@ -81,7 +81,7 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
             be(&mut w, *v)?;
         }
     }
-    // random fields (MODEL.md §12), in the units of their names
+    // random fields (docs/model.md §12), in the units of their names
     for f in &o.fields {
         let (name, unit) = f.label();
         writeln!(w, "\nSCALARS {name} float 1\nLOOKUP_TABLE default")?;

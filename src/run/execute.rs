@@ -20,7 +20,7 @@ use std::time::Instant;
 
 /// Particle stresses (3.18) at positions x, in D dimensions: σ_i = (1/(2ΔV_i))·Σ_j
 /// L0,ij·F_s,ij·(e_ij ⊗ e_ij) with F_s,ij = a_i·S_ij + b_i·θ_i (a_i + c_i in an FCC
-/// second-neighbour slot, MODEL.md §3 erratum; θ_i = Σ_m w_im·S_im, `Mechanics::weights`)
+/// second-neighbour slot, docs/model.md §3 erratum; θ_i = Σ_m w_im·S_im, `Mechanics::weights`)
 /// and e_ij the current bond direction.
 pub fn particle_stress<const D: usize, const K: usize>(
     mech: &Mechanics<D, K>,
@@ -153,7 +153,7 @@ fn stress_2d<const K: usize>(p: &Prepared<K>, sim: &Simulation<2, K>) -> Recover
 }
 
 /// The stress of a 3D run: D·ε_i with ε_i each particle's least-squares strain of its own
-/// (damaged elastic) bond stretches (MODEL.md §7, §13), as in the bulk of 2D; with damage,
+/// (damaged elastic) bond stretches (docs/model.md §7, §13), as in the bulk of 2D; with damage,
 /// each particle's damage.
 fn stress_3d<const K: usize>(p: &Prepared<K, 3>, sim: &Simulation<3, K>) -> Recovered {
     let x = &sim.state.x;

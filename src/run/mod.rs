@@ -1,4 +1,4 @@
-//! `run(scene) -> Outcome`: the whole pipeline of one specimen (ARCHITECTURE.md), in three
+//! `run(scene) -> Outcome`: the whole pipeline of one specimen (docs/architecture.md), in three
 //! stages that run one way:
 //!
 //! 1. [`prepare`]: scene → body (discretisation, groups, supports, micro-moduli, random

@@ -16,7 +16,7 @@ use crate::solver::{modal, Probe};
 use nalgebra::Vector2;
 use serde::Serialize;
 
-/// How the lattice's boundary particles were weighted (`discretisation.surface`; MODEL.md §1,
+/// How the lattice's boundary particles were weighted (`discretisation.surface`; docs/model.md §1,
 /// §3): their count, the fits, and the body's volume against the particles'.
 #[derive(Clone, Debug, Serialize)]
 pub struct SurfaceCorrection {
@@ -49,7 +49,7 @@ pub struct RandomBody {
     pub moduli: ModuliFit,
 }
 
-/// The per-particle least-squares micro-moduli of a random body (MODEL.md §3, (3.20)).
+/// The per-particle least-squares micro-moduli of a random body (docs/model.md §3, (3.20)).
 #[derive(Clone, Debug, Serialize)]
 pub struct ModuliFit {
     /// ‖a_i·A_i + b_i·B_i − D‖/‖D‖ of each particle (NaN where no fit exists).
@@ -139,7 +139,7 @@ pub struct Model<const K: usize = 6, const D: usize = 2> {
     pub mech: Mechanics<D, K>,
     pub bulk: MicroModuli,
     pub surface: SurfaceCorrection,
-    /// The scene's random fields sampled at the particles (MODEL.md §12).
+    /// The scene's random fields sampled at the particles (docs/model.md §12).
     pub fields: Vec<SampledField>,
     /// Random particles only: cells, generation, fitted moduli.
     pub random: Option<RandomBody>,
@@ -326,7 +326,7 @@ fn assemble<const K: usize>(
             &mut surface,
         )?;
     }
-    // Random particles: every particle's own least-squares constants (MODEL.md §3, (3.20)).
+    // Random particles: every particle's own least-squares constants (docs/model.md §3, (3.20)).
     let target = match (&random_body, calibrate) {
         (Some((_, generation)), true) => {
             let md = generation.min_distance;
@@ -349,7 +349,7 @@ fn assemble<const K: usize>(
     if !scene.random_field.is_empty() {
         stage("random fields");
     }
-    // Random fields (MODEL.md §12), over the body's box: E scales the micro-moduli here, the
+    // Random fields (docs/model.md §12), over the body's box: E scales the micro-moduli here, the
     // concrete values go to the damage kernel (`build_simulation`).
     // The box is widened by a margin that does not depend on the spacing (particles may sit
     // on the outline within the lattice fill's tolerance, 1e-9·size).
@@ -448,7 +448,7 @@ pub(crate) fn supports<const D: usize, const K: usize>(
     Ok((groups, constrained, prescribed))
 }
 
-/// The boundary treatment of a lattice body (`discretisation.surface`, MODEL.md §1, §3) into
+/// The boundary treatment of a lattice body (`discretisation.surface`, docs/model.md §1, §3) into
 /// `particles.volume` and the micro-moduli `a`, `b` (which hold each particle's bulk
 /// constants on entry).
 ///

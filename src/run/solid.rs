@@ -1,4 +1,4 @@
-//! The body and model of a 3D scene (`discretisation.lattice = "fcc"`, issue "3D"): the FCC
+//! The body and model of a 3D scene (`discretisation.lattice = "fcc"`): the FCC
 //! lattice in the scene's solid, its boundary treatment and micro-moduli, its groups and
 //! supports ([`prepare_model_solid`]), then the same dynamics as 2D ([`prepare_solid`]).
 //! `[concrete]` runs the same damage kernel as 2D (`solver::concrete`, with the FCC
@@ -314,7 +314,7 @@ pub struct ModuliReport {
 }
 
 /// The bulk constants (a, b, c) of an FCC particle with nearest spacing `l0` under the
-/// weighted dilatation the lattice runs with (MODEL.md §3 with its erratum; the closed forms
+/// weighted dilatation the lattice runs with (docs/model.md §3 with its erratum; the closed forms
 /// (4.8) hold for the source's unweighted θ, see [`fit_fcc_weighted`]): the exact fit of the
 /// 18 bonds and the full cell to the isotropic D.
 pub fn bulk_moduli(e: f64, nu: f64, l0: f64) -> FccModuli {
@@ -332,7 +332,7 @@ pub fn bulk_moduli(e: f64, nu: f64, l0: f64) -> FccModuli {
         .moduli
 }
 
-/// Set a, b, c of every particle of an FCC body for the isotropic (E, ν) (MODEL.md §3 with
+/// Set a, b, c of every particle of an FCC body for the isotropic (E, ν) (docs/model.md §3 with
 /// its erratum) and its volume `p.volume` (the full cell, or the cell clipped to the body,
 /// `voronoi3::fcc_clipped_volumes`), for the weighted dilatation θ_i = Σ_m (L0,im/ℓ_i)·S_im
 /// the lattice runs with ([`FccLattice::fill`](crate::discretise::fcc::FccLattice::fill) sets it): [`bulk_moduli`] scaled by the

@@ -1,8 +1,8 @@
 //! The stress the outputs show (maps, VTK, CSV): the recovered stress σ_i = D_i·ε_i
-//! (MODEL.md §7 and §13), with D_i the isotropic elasticity matrix of the scene's (E, ν) and
+//! (docs/model.md §7 and §13), with D_i the isotropic elasticity matrix of the scene's (E, ν) and
 //! plane, scaled by the particle's own E where a random field varies it.
 //!
-//! **Decision (measured, issue "Surfaces"; docs/surfaces.md).**
+//! **Decision (measured; docs/surfaces.md).**
 //!
 //! - *Bulk particles* (all six bonds): ε_i is the least-squares strain of the particle's own
 //!   (damaged elastic) bond stretches (`model::strain`). In the bulk of a lattice D·ε_i is
@@ -165,7 +165,7 @@ pub fn elastic_stress<const K: usize>(model: &Model<K>, x: &[Vector2<f64>]) -> V
 
 /// The stress D·ε_i of each particle of a 3D model from its strain ε_i (the least-squares
 /// strain of its own bond stretches, [`elastic_strain`] or the concrete kernel's damaged
-/// elastic one; MODEL.md §7, §13): exact in the bulk of the FCC lattice under a homogeneous
+/// elastic one; docs/model.md §7, §13): exact in the bulk of the FCC lattice under a homogeneous
 /// strain. The surface recovery of 2D (the affine patch fit) is not carried to 3D yet.
 pub fn stress_3d<const K: usize>(
     model: &Model<K, 3>,

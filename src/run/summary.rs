@@ -9,7 +9,7 @@ use crate::solver::concrete::ParticleDamage;
 use crate::solver::Record;
 use serde::Serialize;
 
-/// The summary of a run (summary.json; the keys ARCHITECTURE.md names, and more).
+/// The summary of a run (summary.json; the keys docs/architecture.md names, and more).
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     pub scene: String,
@@ -147,7 +147,7 @@ pub struct Outcome {
     pub damage: Option<Vec<ParticleDamage>>,
     pub groups: Vec<groups::Group>,
     pub scene: Scene,
-    /// The random fields' values at each particle (MODEL.md §12).
+    /// The random fields' values at each particle (docs/model.md §12).
     pub fields: Vec<SampledField>,
     /// The names of the maps' horizontal and vertical axes: "x", "y" in 2D; a section of a
     /// 3D run (`output::section`) names its own.

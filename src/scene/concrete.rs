@@ -1,4 +1,4 @@
-//! Concrete parameters and the correlations of MODEL.md §11 (the source's chapter 5), with
+//! Concrete parameters and the correlations of docs/model.md §11 (the source's chapter 5), with
 //! exact unit conversions, and the softening constants derived from them (§8, (5.4)).
 //!
 //! A value given in the scene always wins over a correlation; [`resolve`] returns the values
@@ -6,7 +6,7 @@
 
 use serde::Serialize;
 
-/// 1 psi in Pa (exact to the digits of MODEL.md §11).
+/// 1 psi in Pa (exact to the digits of docs/model.md §11).
 pub const PSI: f64 = 6894.757;
 /// 1 lb/ft³ in kg/m³.
 pub const LB_PER_FT3: f64 = 16.01846;
@@ -28,7 +28,7 @@ pub fn ceb_fip_fracture_energy(gf0: f64, fc: f64) -> f64 {
 }
 
 /// Base fracture energy G_f0 (N/m) for a maximum aggregate size (m): CEB-FIP 1990 gives
-/// 25, 30 and 58 N/m for 8, 16 and 32 mm; the source uses 33.49 N/m for 19 mm (VALIDATION.md
+/// 25, 30 and 58 N/m for 8, 16 and 32 mm; the source uses 33.49 N/m for 19 mm (docs/validation.md
 /// §B, §C; linear interpolation of the CEB-FIP table would give 35.25 N/m). Other sizes are
 /// refused: give `concrete.Gf0` instead.
 pub fn base_fracture_energy(max_aggregate: f64) -> Option<f64> {
@@ -50,13 +50,13 @@ pub fn critical_crack_opening(gf: f64, ft: f64, alpha: f64, gamma: f64) -> f64 {
 #[derive(Clone, Copy, Debug, serde::Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Preset {
-    /// Table 1 of 002 (section 5.2, block in tension and compression): f'c = 27.58 MPa
+    /// Table 1 of Nikravesh Kazeroni (2017) (section 5.2, block in tension and compression): f'c = 27.58 MPa
     /// (4000 psi), d_max = 19 mm.
     SplmBlock,
-    /// Table 5 of 002, split cylinder (section 5.3.3): f'c = 41.23 MPa, d_max = 19 mm.
+    /// Table 5 of Nikravesh Kazeroni (2017), split cylinder (section 5.3.3): f'c = 41.23 MPa, d_max = 19 mm.
     SplmCylinder,
-    /// Table 5 of 002, dog-bones (section 5.3.2): f'c = 50 MPa, d_max = 8 mm, and the
-    /// table's f't = 2.415 MPa (not the ACI value 3.52 MPa; VALIDATION.md §D).
+    /// Table 5 of Nikravesh Kazeroni (2017), dog-bones (section 5.3.2): f'c = 50 MPa, d_max = 8 mm, and the
+    /// table's f't = 2.415 MPa (not the ACI value 3.52 MPa; docs/validation.md §D).
     SplmDogbone,
 }
 

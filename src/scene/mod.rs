@@ -1,5 +1,5 @@
 //! Scene files: the TOML description of one specimen, its discretisation, material, loading
-//! and outputs (ARCHITECTURE.md, "scene"). Parsing rejects unknown keys (serde's
+//! and outputs (docs/architecture.md, "scene"). Parsing rejects unknown keys (serde's
 //! `deny_unknown_fields`), and [`Scene::validate`] rejects impossible values, each with one
 //! message that names the key, the value and what is allowed.
 
@@ -36,10 +36,10 @@ pub struct Scene {
     pub cutouts: Vec<CutoutSpec>,
     pub discretisation: DiscretisationSpec,
     pub material: MaterialSpec,
-    /// Concrete damage and plasticity (MODEL.md §6–9, §11); its presence turns them on.
+    /// Concrete damage and plasticity (docs/model.md §6–9, §11); its presence turns them on.
     #[serde(default)]
     pub concrete: Option<ConcreteSpec>,
-    /// Random-field material properties (MODEL.md §12), one table per property.
+    /// Random-field material properties (docs/model.md §12), one table per property.
     #[serde(default)]
     pub random_field: Vec<RandomFieldSpec>,
     #[serde(default)]
@@ -61,7 +61,7 @@ pub struct Scene {
 /// The seed of a scene's random choices when it gives none.
 pub const DEFAULT_SEED: u64 = 20_240_401;
 
-/// A material property that a random field can vary per particle (MODEL.md §12).
+/// A material property that a random field can vary per particle (docs/model.md §12).
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 pub enum FieldProperty {
     /// Tensile strength f't.
@@ -109,7 +109,7 @@ pub enum MarginalKind {
 }
 
 /// `[[random_field]]`: one material property drawn per particle from a correlated random
-/// field (MODEL.md §12).
+/// field (docs/model.md §12).
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RandomFieldSpec {
@@ -154,7 +154,7 @@ pub enum BodySpec {
         #[serde(default)]
         centre: [f64; 2],
     },
-    /// van Vliet dog-bone of size D (VALIDATION.md §D).
+    /// van Vliet dog-bone of size D (docs/validation.md §D).
     Dogbone {
         size: f64,
     },
@@ -361,7 +361,7 @@ fn default_offset() -> Vec<f64> {
     vec![0.0, 0.0]
 }
 
-/// How a lattice's boundary particles are weighted (`discretisation.surface`; MODEL.md §1,
+/// How a lattice's boundary particles are weighted (`discretisation.surface`; docs/model.md §1,
 /// §3; measured in benchmarks/RESULTS.md, "Surfaces").
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
@@ -476,7 +476,7 @@ impl MaterialSpec {
     }
 }
 
-/// How tensile damage starts (MODEL.md §8).
+/// How tensile damage starts (docs/model.md §8).
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Initiation {
@@ -486,7 +486,7 @@ pub enum Initiation {
     Interaction,
 }
 
-/// Which crack opening drives the softening law (MODEL.md §8).
+/// Which crack opening drives the softening law (docs/model.md §8).
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum CrackOpening {
@@ -496,7 +496,7 @@ pub enum CrackOpening {
     Inelastic,
 }
 
-/// Concrete (MODEL.md §6–9, §11). Strengths in Pa, G_f in N/m (J/m²), lengths in m. A value
+/// Concrete (docs/model.md §6–9, §11). Strengths in Pa, G_f in N/m (J/m²), lengths in m. A value
 /// left out comes from the preset, else from the correlation of §11, else the default shown.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -704,7 +704,7 @@ pub struct LoadSpec {
     /// Loaded component: "x" or "y".
     pub component: Axis,
     /// Δmax (m): the displacement at the end of the ramp (signed). May be left out in a
-    /// scene with `[concrete]`: it then defaults to +1.5·COD_c (tension, MODEL.md §10).
+    /// scene with `[concrete]`: it then defaults to +1.5·COD_c (tension, docs/model.md §10).
     /// Always set after [`Scene::resolve`].
     #[serde(default)]
     pub displacement: Option<f64>,
@@ -717,11 +717,11 @@ impl LoadSpec {
     }
 }
 
-/// Time history of the displacement loading (MODEL.md §10).
+/// Time history of the displacement loading (docs/model.md §10).
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadingSpec {
-    /// "cosine" (5.5) or "smoothstep" (seed 000, Eq. 4.9).
+    /// "cosine" (5.5) or "smoothstep" (Hobbs (2021), Eq. 4.9).
     #[serde(default = "default_ramp")]
     pub ramp: Ramp,
     /// t_ramp / t_end (5.5 uses 0.8).
@@ -766,7 +766,7 @@ fn default_ramp_fraction() -> f64 {
     0.8
 }
 
-/// Damping ratios (MODEL.md §5).
+/// Damping ratios (docs/model.md §5).
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DampingSpec {
@@ -787,7 +787,7 @@ impl Default for DampingSpec {
     }
 }
 
-/// Which reading of the source's one-step force lag (MODEL.md §4). Default chosen by
+/// Which reading of the source's one-step force lag (docs/model.md §4). Default chosen by
 /// measurement (tests/vibration_and_stability.rs, tests/run_plate.rs):
 ///
 /// - undamped free vibration of a bar over 100 periods: (B) drifts by −6.6e-6 in energy
@@ -866,7 +866,7 @@ pub struct ControlSpec {
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverMethod {
-    /// Damped explicit central differences over the loading time (MODEL.md §4–5).
+    /// Damped explicit central differences over the loading time (docs/model.md §4–5).
     #[default]
     Explicit,
     /// Adaptive dynamic relaxation (Kilic & Madenci 2010) in load increments, the state

@@ -1,4 +1,4 @@
-//! Validation of a scene's random fields (MODEL.md §12): the keys of each `[[random_field]]`
+//! Validation of a scene's random fields (docs/model.md §12): the keys of each `[[random_field]]`
 //! table and the marginal distribution they describe (`crate::random_field`).
 
 use super::{FieldProperty, MarginalKind, Scene, SceneError};

@@ -1,4 +1,4 @@
-//! Filling in derived material values (MODEL.md §11): E, f't, f_y, f_ult, G_f0, G_f, COD_c and
+//! Filling in derived material values (docs/model.md §11): E, f't, f_y, f_ult, G_f0, G_f, COD_c and
 //! the default Δmax in tension, each recorded with its source in [`Scene::derived`]. Inputs
 //! are checked before any correlation sees them, so a bad value is named as the user wrote it.
 
@@ -19,7 +19,7 @@ pub const RANDOM_CRACK_BAND: f64 = 3.2;
 pub const FCC_CRACK_BAND: f64 = 3.3;
 
 /// The crack band of random particles in 3D in units of each particle's mean bond length
-/// (measured: benchmarks/RESULTS.md, "Random particles in 3D", stop 39: the 15 mm tension
+/// (measured: benchmarks/RESULTS.md, "Random particles in 3D": the 15 mm tension
 /// prism dissipates 1.022 × G_f·A with it, mean of 5 particle sets at 3 turns).
 pub const RANDOM_3D_CRACK_BAND: f64 = 4.2;
 
@@ -251,7 +251,7 @@ impl Scene {
                     self.record(
                         &key,
                         1.5 * cod_c,
-                        "1.5·COD_c (tension default, MODEL.md §10)",
+                        "1.5·COD_c (tension default, docs/model.md §10)",
                     );
                 }
             }

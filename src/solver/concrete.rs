@@ -1,10 +1,10 @@
-//! The step kernel with two-spring damage and plasticity (MODEL.md §2, §6–9) on the slot layout.
+//! The step kernel with two-spring damage and plasticity (docs/model.md §2, §6–9) on the slot layout.
 //!
 //! Same shape as the elastic kernel (`kernel.rs`): two gather passes, parallel over particles,
 //! no scatter and no allocation, so results do not depend on the thread count. State variables
 //! (w_t, w_c, the plastic stretch states) have a committed value, read by both passes of a
 //! step, and a trial value written by pass 1; [`Concrete::commit`] swaps them once per step
-//! (reading B of MODEL.md §4: elastic forces from the current positions, state variables from
+//! (reading B of docs/model.md §4: elastic forces from the current positions, state variables from
 //! the previous step).
 //!
 //! 1. Each particle, from its slots: elastic stretch S_e = S_T − ½(S_Ps,ij + S_Ps,ji) (3.38),
@@ -137,7 +137,7 @@ where
 /// The criteria (initiation, yield) of a particle read the volume-weighted mean of the damaged
 /// elastic strains of the particle and its bonded neighbours that carry no tensile damage
 /// (w_t = 0), as they were at the previous step (like every state variable, reading B of
-/// MODEL.md §4).
+/// docs/model.md §4).
 ///
 /// **Decision (measured, random particles).** A random particle's own strain scatters about
 /// the body's (non-affine relaxation, anisotropic particles), so with it the Rankine criterion
@@ -151,7 +151,7 @@ where
 /// particle pulled the mean of the particles at a crack's tip down, so the tip was shielded
 /// and cracks started elsewhere instead (two offset cracks in some sets). Without them, over
 /// the same 10 sets, the tension block's energy went from 1.29 to 1.18 × G_f·A and the split
-/// cylinder's peak from +16.9% to +11.9% over (5.6) (benchmarks/RESULTS.md, stop 21).
+/// cylinder's peak from +16.9% to +11.9% over (5.6) (benchmarks/RESULTS.md).
 #[derive(Clone, Debug)]
 pub struct Neighbourhood<const D: usize> {
     volume: Vec<f64>,
@@ -241,7 +241,7 @@ where
     }
 
     /// The step kernel this law needs: the tension kernel unless it needs plastic stretch and
-    /// the compressive branch (ARCHITECTURE.md, "skip what the scene does not need").
+    /// the compressive branch (docs/architecture.md, "skip what the scene does not need").
     pub fn kernel(&self) -> KernelSet {
         if self.force_full || self.law.kernel() == Kernel::Full {
             KernelSet::Full
@@ -839,7 +839,7 @@ where
 /// One explicit step with damage and plasticity from x^n, v^{n−½} into `x_next`, `v_next`
 /// (not yet swapped in), `force` (the internal force at x^n) and the damper work; then the
 /// trial state is committed. With `LAG`, the force of the previous step drives this one
-/// (reading A of MODEL.md §4; `force_prev` holds it). `FULL = false` is the tension kernel
+/// (reading A of docs/model.md §4; `force_prev` holds it). `FULL = false` is the tension kernel
 /// (see [`update_state`]), valid only for a law that needs no more ([`Kernel::Tension`]).
 pub fn step<
     const D: usize,
@@ -913,7 +913,7 @@ where
 /// The secant stiffness K = −∂F/∂x of the internal forces at positions x with the
 /// committed (held) state, as (row, column, value) triplets over the degrees of freedom
 /// D·i + component: the derivative of the damaged bond force
-/// F_b,ij = ½(d_ij·(m_i + m_j)·S_e,ij + √d_ij·(bθ_i + bθ_j)) along e_ij (MODEL.md §7 with the
+/// F_b,ij = ½(d_ij·(m_i + m_j)·S_e,ij + √d_ij·(bθ_i + bθ_j)) along e_ij (docs/model.md §7 with the
 /// kernel's damage decision above), with d, √d and each bond's branch held, the bond
 /// directions e taken at x and held (the geometric stiffness, of relative size S ≈ 1e-4, is
 /// left out), and dS_e,ij = e_ij·(dx_j − dx_i)/L0,ij. For the quasi-static solver's secant
@@ -964,7 +964,7 @@ where
                 if let Some(s) = slot::<D, K, L, FULL>(m, c, x, i, k) {
                     // a broken bond (d = √d = 0) adds zeros, also where its ends have met
                     // and its direction is not defined (met on the split cylinder after
-                    // cracking, with a variant of the solver measured at stop 34: NaN
+                    // cracking, with a variant of the solver measured once: NaN
                     // entries, then a failed factorisation); the entries stay, as the
                     // pattern is built once
                     let broken = s.d == 0.0 && s.sd == 0.0;
@@ -1091,7 +1091,7 @@ where
 }
 
 /// Each particle's least-squares strain of its damaged elastic stretches d_ij·S_e,ij at
-/// positions x (MODEL.md §7 and §13: the strain the criteria stress D·ε reads); the stress
+/// positions x (docs/model.md §7 and §13: the strain the criteria stress D·ε reads); the stress
 /// the outputs show is D_i times it (`model::stress`, "recovered stress").
 pub fn particle_strain<const D: usize, const K: usize, L: DamageLaw<D, K>>(
     m: &Mechanics<D, K>,
@@ -1708,7 +1708,7 @@ mod tests {
     }
 
     /// The same in 3D on an FCC block with second-neighbour moduli c and weighted
-    /// dilatations (slots 12..18 take a + c, MODEL.md §3 erratum), not a multiple of 4.
+    /// dilatations (slots 12..18 take a + c, docs/model.md §3 erratum), not a multiple of 4.
     #[test]
     fn fcc_pass_state_with_second_neighbours_simd_matches_scalar_bitwise() {
         let fcc = fcc_body();

@@ -1,5 +1,5 @@
 //! The explicit elastic step kernel on the CSR bond layout ([`Csr`]: a varying number of
-//! bonds per particle, MODEL.md §1), the counterpart of `solver::kernel` for the slot layout.
+//! bonds per particle, docs/model.md §1), the counterpart of `solver::kernel` for the slot layout.
 //!
 //! The same two gather passes per step, parallel over fixed chunks of particles with no
 //! scatter, atomics or allocation, so results do not depend on the thread count:
@@ -31,7 +31,7 @@
 //! the slot kernel's (whose AVX path is tested bit-identical to its scalar path):
 //! `tests/csr_layout.rs` checks this over 1,000 steps.
 //!
-//! `LAG = true` is reading (A) of MODEL.md §4: the force from the previous step's positions
+//! `LAG = true` is reading (A) of docs/model.md §4: the force from the previous step's positions
 //! drives this step.
 
 use super::kernel::{central_difference, chunk_len, update_in_chunks, use_avx, ChunkOut, State};
@@ -68,7 +68,7 @@ fn check_sizes<const D: usize, const K: usize>(csr: &Csr, m: &Mechanics<D, K>, n
         m.len()
     );
     assert!(m.c_in.len() == n && m.c_ex.len() == n && m.inv_mass.len() == n);
-    // CSR bonds have no slots, so no second-neighbour slots (MODEL.md §3, FCC)
+    // CSR bonds have no slots, so no second-neighbour slots (docs/model.md §3, FCC)
     m.assert_no_second("the CSR kernel");
 }
 

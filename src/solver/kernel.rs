@@ -1,4 +1,4 @@
-//! The explicit step kernel (ARCHITECTURE.md, "The step kernel"; MODEL.md §2–5).
+//! The explicit step kernel (docs/architecture.md, "The step kernel"; docs/model.md §2–5).
 //!
 //! Two gather passes per step, parallel over chunks of particles, with no scatter, atomics or
 //! allocation, so results do not depend on the thread count:
@@ -8,7 +8,7 @@
 //!    F_b,ij = ½(F_s,ij + F_s,ji) = ½((a_i + a_j)·S_ij + bθ_i + bθ_j) (3.7, 3.8) along the
 //!    current unit vector e_ij, plus the bond damper (3.55), then central differences
 //!    (3.58) with the particle damper (3.56) taken semi-implicitly. In an FCC
-//!    second-neighbour slot (`Mechanics::second`, MODEL.md §3 with its erratum) the bond
+//!    second-neighbour slot (`Mechanics::second`, docs/model.md §3 with its erratum) the bond
 //!    moduli are a + c: F_b,ij = ½((a_i + c_i) + (a_j + c_j))·S_ij + ½(bθ_i + bθ_j). The
 //!    test of whether a model has c is made once per particle (scalar) or per block of four
 //!    (AVX), outside the slot loop; without c the code is the one without it.
@@ -20,7 +20,7 @@
 //! AVX and other architectures (checked by the test at the end of this file).
 //!
 //! Writing F_b through bθ uses that S_ji = S_ij, so F_s,ji never needs the neighbour's other
-//! bonds. `LAG = true` is the literal reading (A) of MODEL.md §4: the force from the previous
+//! bonds. `LAG = true` is the literal reading (A) of docs/model.md §4: the force from the previous
 //! step's positions drives this step.
 
 use super::mechanics::{weighted, Mechanics};
@@ -1137,7 +1137,7 @@ mod tests {
         }
     }
 
-    /// (a) of issue 15's kernel: on a randomly perturbed FCC block (`bench::fcc_block`: 18
+    /// (a) of the FCC kernel: on a randomly perturbed FCC block (`bench::fcc_block`: 18
     /// slots, second neighbours in 12..18) with per-particle a, b and c ≠ 0, moving, the AVX
     /// blocks and the scalar code agree bit for bit, and c changes the forces.
     #[test]

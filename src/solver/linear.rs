@@ -1,7 +1,7 @@
 //! The linearised SPLM operator about the reference configuration, matrix-free:
 //! (K·u)_i = −f_i(u) with S_ij = n_ij·(u_j − u_i)/L0_ij, θ_i = Σ_m S_im and
-//! f_i = Σ_j ½((a_i + a_j)·S_ij + b_i·θ_i + b_j·θ_j)·n_ij (MODEL.md §3–4 linearised), with
-//! a + c in place of a in FCC second-neighbour slots (MODEL.md §3 erratum,
+//! f_i = Σ_j ½((a_i + a_j)·S_ij + b_i·θ_i + b_j·θ_j)·n_ij (docs/model.md §3–4 linearised), with
+//! a + c in place of a in FCC second-neighbour slots (docs/model.md §3 erratum,
 //! `Mechanics::bond_moduli`).
 //! Used for the fundamental period and for the patch test at round-off accuracy.
 

@@ -1,5 +1,5 @@
-//! Displacement loading (MODEL.md §10): the 1−cos ramp (5.5) and the 5th-order smooth step
-//! (seed 000, Eq. 4.9), held at Δmax after t_ramp.
+//! Displacement loading (docs/model.md §10): the 1−cos ramp (5.5) and the 5th-order smooth step
+//! (Hobbs (2021), Eq. 4.9), held at Δmax after t_ramp.
 
 use crate::scene::Ramp;
 

@@ -1,7 +1,7 @@
 //! Per-particle static data of the step kernel, in structure-of-arrays form, allocated once:
 //! neighbour slots, 1/L0 per slot, micro-moduli, masses and damper coefficients.
 //!
-//! FCC second neighbours (MODEL.md §3 with its erratum): the force state of particle i in
+//! FCC second neighbours (docs/model.md §3 with its erratum): the force state of particle i in
 //! the direction of j is F_s,ij = (a_i + c_i·[j ∈ N_II])·S_ij + b_i·θ_i, so a bond in a
 //! second-neighbour slot has the bond modulus a + c at each end and the bond force
 //! ½((a_i + c_i) + (a_j + c_j))·S_ij + ½(bθ_i + bθ_j). [`Mechanics::second`] holds c and
@@ -29,7 +29,7 @@ pub struct Mechanics<const D: usize, const K: usize> {
     pub a: Aligned<f64>,
     /// Micro-modulus b_i (N).
     pub b: Aligned<f64>,
-    /// The second-neighbour modulus c_i and the slots it acts in (FCC, MODEL.md §3 erratum);
+    /// The second-neighbour modulus c_i and the slots it acts in (FCC, docs/model.md §3 erratum);
     /// `None` where no particle has a c (2D, random particles).
     pub second: Option<SecondNeighbours>,
     pub mass: Aligned<f64>,
@@ -74,7 +74,7 @@ impl<const D: usize, const K: usize> Default for Mechanics<D, K> {
     }
 }
 
-/// The FCC second-neighbour micro-modulus (MODEL.md §3 with its erratum): slots
+/// The FCC second-neighbour micro-modulus (docs/model.md §3 with its erratum): slots
 /// `first_slot..K` hold second neighbours (N_II), whose bonds have modulus a_i + c_i at
 /// particle i's end.
 #[derive(Clone, Debug)]
@@ -228,7 +228,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
     }
 
     /// The bond moduli (at i's end, at j's end) of the bond in slot k of particle i to j:
-    /// (a_i, a_j), or (a_i + c_i, a_j + c_j) in a second-neighbour slot (MODEL.md §3
+    /// (a_i, a_j), or (a_i + c_i, a_j + c_j) in a second-neighbour slot (docs/model.md §3
     /// erratum). The bond force is `bond_force(mi, mj, S, bθ_i, bθ_j)` and particle i's force
     /// state `force_state(mi, S, bθ_i)` with (mi, mj) from here.
     #[inline(always)]
@@ -255,7 +255,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
     pub fn assert_no_second(&self, what: &str) {
         assert!(
             self.second.is_none(),
-            "{what} does not implement the second-neighbour modulus c (MODEL.md §3, FCC)"
+            "{what} does not implement the second-neighbour modulus c (docs/model.md §3, FCC)"
         );
     }
 

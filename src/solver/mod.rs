@@ -1,5 +1,5 @@
 //! Time integration of a discretised specimen: the step kernel, displacement loading,
-//! probes (reaction force, energies) and the stability guard (ARCHITECTURE.md, "Solver").
+//! probes (reaction force, energies) and the stability guard (docs/architecture.md, "Solver").
 
 pub mod concrete;
 pub mod csr_kernel;
@@ -37,7 +37,7 @@ use nalgebra::SVector;
 use crate::scene::Ramp;
 
 /// The step kernel a run uses, chosen once before the loop from the features the scene turns
-/// on (ARCHITECTURE.md, "skip what the scene does not need"): the elastic kernel (no
+/// on (docs/architecture.md, "skip what the scene does not need"): the elastic kernel (no
 /// `[concrete]`), the tension kernel (tensile damage only: no plastic stretch, no w_c, no
 /// yield test), or the full kernel (compressive damage and/or plasticity).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -62,7 +62,7 @@ impl KernelSet {
 #[derive(Clone, Copy, Debug)]
 pub struct Integration {
     pub dt: f64,
-    /// Reading (A) of MODEL.md §4 when true.
+    /// Reading (A) of docs/model.md §4 when true.
     pub lagged_forces: bool,
     pub ramp: Ramp,
     pub t_ramp: f64,
@@ -520,8 +520,8 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     }
 
     /// Elastic energy stored in the bonds at the current positions,
-    /// U = ¼·Σ_i Σ_j L0,ij·S_ij·F_s,ij (so that ∂U/∂L_ij = F_b,ij; see MODEL.md §7), with
-    /// the FCC second-neighbour term ¼·c_i·Σ_{j∈N_II} L0,ij·S_ij² (MODEL.md §3 erratum).
+    /// U = ¼·Σ_i Σ_j L0,ij·S_ij·F_s,ij (so that ∂U/∂L_ij = F_b,ij; see docs/model.md §7), with
+    /// the FCC second-neighbour term ¼·c_i·Σ_{j∈N_II} L0,ij·S_ij² (docs/model.md §3 erratum).
     pub fn internal_energy_now(&self) -> f64 {
         if let Some(model) = &self.inelastic {
             return model.internal_energy(&self.mech, &self.state.x);

@@ -1,4 +1,4 @@
-//! The fundamental period T1 of the constrained specimen (MODEL.md §5), computed by the tool
+//! The fundamental period T1 of the constrained specimen (docs/model.md §5), computed by the tool
 //! instead of typed in: the lowest eigenvalue of K·φ = λ·M·φ of the linearised operator by
 //! Lanczos ([`super::lanczos`]). (Inverse iteration with CG solves was 4–5× slower: each
 //! solve needs as many iterations as the whole Lanczos run.) Rigid-body motions that the

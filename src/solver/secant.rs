@@ -90,7 +90,7 @@ const GAUGE_REMEDY: &str = "end the run at a smaller solver.control.opening, or 
 
 /// Free components from which the factorisation and solves run on faer's threads. Below it
 /// they run on one: on the split cylinder (1,602 unknowns) the threads' synchronisation made
-/// the run 10.4 s against 8.4 s on one thread (stop 35, one run each). Above it, faer's
+/// the run 10.4 s against 8.4 s on one thread (one run each). Above it, faer's
 /// default (not measured here: the 2D scenes have at most 7,000 unknowns).
 const PARALLEL_DOFS: usize = 20_000;
 
@@ -138,7 +138,7 @@ impl Dofs {
 
 /// The free-component stiffness: its lower triangle's pattern, the symbolic Cholesky and
 /// the numeric factor, all built once and refilled in place (no allocation per
-/// factorisation; measured at stop 35: the allocating `faer::sparse::linalg::solvers::Llt`
+/// factorisation; measured: the allocating `faer::sparse::linalg::solvers::Llt`
 /// spent most of its time in the allocator and the kernel's page faults).
 struct Factor {
     /// The (row, column) of each triplet of `concrete::secant_stiffness` when the pattern

@@ -1,4 +1,4 @@
-//! The stable time step of the explicit scheme (MODEL.md §5), from the actual stiffness,
+//! The stable time step of the explicit scheme (docs/model.md §5), from the actual stiffness,
 //! masses and damping.
 //!
 //! For central differences with the bond dampers taken at v^{n−½} (explicitly) the limit of

@@ -1,4 +1,4 @@
-//! The Monte Carlo study of the statistical size effect (MODEL.md §12, VALIDATION.md §D): N
+//! The Monte Carlo study of the statistical size effect (docs/model.md §12, docs/validation.md §D): N
 //! realisations of the scene's random fields per specimen size, each with its own seed, plus
 //! one deterministic run per size (the random fields removed: the mean properties
 //! everywhere), and the size-effect statistics and fits ([`super::size_effect`]).
@@ -47,7 +47,7 @@ use serde_json::json;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The van Vliet dog-bone sizes A–F (VALIDATION.md §D): D in m.
+/// The van Vliet dog-bone sizes A–F (docs/validation.md §D): D in m.
 pub const DOGBONE_SIZES: [(char, f64); 6] = [
     ('A', 0.05),
     ('B', 0.1),

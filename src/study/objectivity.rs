@@ -1,7 +1,7 @@
 //! The objectivity study: the same scene at several lattice rotations, each with the
 //! scene's own lattice offset (offset 0) and N random offsets, to measure how much the
 //! peak force, the energy and the crack path depend on how the lattice sits in the body
-//! (VALIDATION.md §B–C: the goal is a peak-force spread of at most 3%).
+//! (docs/validation.md §B–C: the goal is a peak-force spread of at most 3%).
 //!
 //! Random offsets are uniform in the lattice cell: offset k ≥ 1 adds u·a1 + v·a2 to the
 //! scene's offset, with a1, a2 the rotated lattice vectors and (u, v) uniform in [0, 1)²

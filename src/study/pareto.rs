@@ -1,4 +1,4 @@
-//! Run time against error (issue 4, item 3): the Pareto front of a sweep of solver and
+//! Run time against error: the Pareto front of a sweep of solver and
 //! discretisation settings, and how near the shipped defaults lie to it.
 //!
 //! A sweep varies one setting at a time around the scene's defaults (lattice spacing, time-step
@@ -27,7 +27,7 @@ pub struct SweepRun {
     #[serde(rename = "peak_force_N")]
     pub peak_force_n: f64,
     pub status: String,
-    /// The solver (`solver.method`); runs.csv files written before issue 16 lack it.
+    /// The solver (`solver.method`); runs.csv files written before the quasi-static solver existed lack it.
     #[serde(default = "explicit")]
     pub method: String,
     /// Load increments of the relaxation and quasi-static solvers.

@@ -301,7 +301,7 @@ pub fn wait_until(limit: std::time::Duration, what: &str, ready: impl Fn() -> bo
     }
 }
 
-/// The split cylinder's reference peak (5.6) (Rocco et al., VALIDATION.md §C):
+/// The split cylinder's reference peak (5.6) (Rocco et al., docs/validation.md §C):
 /// P = (π/2)·f't·D·H / (1 − β²)^1.5 with β = b/D, for diameter `d`, length `h` and strip
 /// width `b`.
 pub fn split_cylinder_peak(ft: f64, d: f64, h: f64, b: f64) -> f64 {

@@ -122,7 +122,7 @@ pub(super) unsafe fn slot_block<
     let half = _mm256_set1_pd(0.5);
     let xi = load_own(x, i0);
     let ai = _mm256_loadu_pd(m.a.as_ptr().add(i0));
-    // second-neighbour moduli (FCC, MODEL.md §3 erratum): c per particle, a_i + c_i and the
+    // second-neighbour moduli (FCC, docs/model.md §3 erratum): c per particle, a_i + c_i and the
     // first second-neighbour slot (K: none)
     let (sc, aci, first): (&[f64], __m256d, usize) = match &m.second {
         Some(s) => (
