@@ -66,7 +66,7 @@ fn fitted<const D: usize, const K: usize>(
         &crate::discretise::Particles<D, K>,
         &mut [f64],
         &mut [f64],
-    ) -> crate::run::prepare::ModuliFit,
+    ) -> crate::run::model::ModuliFit,
 ) -> anyhow::Result<Setup> {
     let t = Instant::now();
     let (mut a, mut b) = (std::mem::take(&mut p.a), std::mem::take(&mut p.b));
@@ -186,7 +186,7 @@ pub fn bench(
                 .map_err(|e| anyhow::anyhow!("random particles: {e}"))?;
             let d = micro_modulus::elasticity_matrix(30e9, 0.2, Plane::Stress);
             let setup = fitted(&mut p, &g, |p, a, b| {
-                crate::run::prepare::fit_moduli(p, &d, a, b)
+                crate::run::generate::moduli::fit_moduli(p, &d, a, b)
             })?;
             time_steps(p, steps, threads, kernel, layout, Some(setup), simd)
         }
@@ -339,7 +339,7 @@ pub const fn fcc_block_len(cells: usize) -> usize {
 /// (`discretise::fcc::bulk_moduli`).
 pub fn fcc_block(cells: usize, l0: f64) -> Particles<3, 18> {
     use crate::discretise::fcc::FccLattice;
-    use crate::run::solid::bulk_moduli;
+    use crate::run::generate::moduli::bulk_moduli;
     let side = cells as f64 * 2f64.sqrt() * l0;
     let mut p = FccLattice {
         spacing: l0,
@@ -447,7 +447,7 @@ pub fn bench_random3(
                 Plane::Stress,
             );
         let setup = fitted(&mut p, &g, |p, a, b| {
-            crate::run::prepare::fit_moduli_3d(p, &d, a, b)
+            crate::run::generate::moduli::fit_moduli_3d(p, &d, a, b)
         })?;
         Ok((p, setup))
     })?;

@@ -3,7 +3,7 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use sppm::fsio::{FolderBusy, IoFailure};
-use sppm::run::{estimated_memory, prepare_with, RunOptions};
+use sppm::run::{estimated_memory, RunOptions};
 use sppm::{say, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -85,7 +85,7 @@ enum Command {
 /// (a 2.3e6-particle plate takes minutes to set up).
 const CHECK_PROGRESS_PARTICLES: f64 = 5e4;
 
-/// Exit statuses (README, docs/reliability.md).
+/// Exit statuses (docs/cli.md, docs/reliability.md).
 mod exit {
     /// Bad input: a malformed scene, an impossible parameter or count.
     pub const BAD_INPUT: u8 = 2;
@@ -183,19 +183,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     eprintln!("[{:7.1} s] {what}…", started.elapsed().as_secs_f64());
                 }
             };
-            if sc.dim() == 3 && sc.discretisation.is_random() {
-                let p = sppm::run::solid::prepare_random_solid(&sc, &stage)?;
-                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
-            } else if sc.dim() == 3 {
-                let p = sppm::run::solid::prepare_solid(&sc, &stage)?;
-                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
-            } else if sppm::run::prepare::slots_of(&sc) == sppm::discretise::random::SLOTS_2D {
-                let p = prepare_with::<{ sppm::discretise::random::SLOTS_2D }>(&sc, &stage)?;
-                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
-            } else {
-                let p = prepare_with::<6>(&sc, &stage)?;
-                check(&sc, mem, &stage, p, &sppm::run::build_simulation)?;
-            }
+            sppm::run::dispatch(&sc, Check { mem, stage: &stage })?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Bench {
@@ -280,20 +268,41 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// `sppm check` of a prepared scene (2D, or 3D: FCC or random particles), its simulation built by
-/// `simulate`: the body, groups, T1, time step, memory and the run time from a few timed
-/// steps.
+/// `sppm check` of a scene with its generator: the body, groups, T1, time step, memory and
+/// the run time from a few timed steps of the real kernel.
+struct Check<'a> {
+    mem: f64,
+    stage: &'a dyn Fn(&str),
+}
+
+impl sppm::run::TypedRun for Check<'_> {
+    type Output = anyhow::Result<()>;
+
+    fn run<G, const D: usize, const K: usize>(self, sc: &Scene, generator: G) -> Self::Output
+    where
+        G: sppm::run::Generator<D, K>,
+        sppm::model::dimension::Dim<D>:
+            sppm::model::dimension::Dimension<D> + sppm::run::recover::Recover<D>,
+    {
+        let p = sppm::run::prepare_with(sc, generator, self.stage)?;
+        check(sc, self.mem, self.stage, p)
+    }
+}
+
+/// `sppm check` of a prepared scene (2D, or 3D: FCC or random particles).
 fn check<const K: usize, const D: usize>(
     sc: &Scene,
     mem: f64,
     stage: &dyn Fn(&str),
     mut p: sppm::run::Prepared<K, D>,
-    simulate: &dyn Fn(&mut sppm::run::Prepared<K, D>) -> sppm::solver::Simulation<D, K>,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<()>
+where
+    sppm::model::dimension::Dim<D>: sppm::model::dimension::Dimension<D>,
+{
     stage("timing a few steps of the kernel");
     // calibrate the run time with a few steps of the real kernel (with damage and
     // plasticity where the scene has them)
-    let mut sim = simulate(&mut p);
+    let mut sim = sppm::run::build_simulation(&mut p);
     let calib = 20.min(p.steps.max(1));
     let t = std::time::Instant::now();
     for _ in 0..calib {

@@ -71,7 +71,7 @@ pub fn write_increments(
     Ok(())
 }
 
-/// Columns of particles.csv (README, "Outputs").
+/// Columns of particles.csv (docs/outputs.md).
 pub const PARTICLE_COLUMNS: [&str; 7] =
     ["x_m", "y_m", "ux_m", "uy_m", "sxx_Pa", "syy_Pa", "sxy_Pa"];
 

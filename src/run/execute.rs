@@ -1,10 +1,12 @@
 //! Stage 2 of a run: the explicit or relaxation solver on a prepared model, with probes, to
 //! a dimension-erased [`Outcome`].
 
-use super::prepare::{prepare_with, slots_of, Prepared};
-use super::summary::{point3, summarise, voigt6, Finished, Outcome, SolverReport};
-use super::{stress_recovery, RunError, RunOptions};
-use crate::discretise::random;
+use super::dispatch::{dispatch, TypedRun};
+use super::generate::Generator;
+use super::prepare::{prepare, Prepared};
+use super::recover::{Recover, Recovered};
+use super::summary::{point3, summarise, Finished, Outcome, SolverReport};
+use super::{RunError, RunOptions};
 use crate::material::properties;
 use crate::model::dimension::{Dim, Dimension};
 use crate::model::force_state::{dilatation_term, force_state};
@@ -12,7 +14,7 @@ use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
 use crate::scene::{Scene, SolverMethod};
-use crate::solver::concrete::{Concrete, ParticleDamage};
+use crate::solver::concrete::Concrete;
 use crate::solver::mechanics::{weighted, Mechanics};
 use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
 use nalgebra::{SMatrix, SVector};
@@ -65,26 +67,32 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
         .num_threads(threads)
         .build()
         .map_err(|e| RunError::Setup(format!("cannot start {threads} threads: {e}")))?;
-    pool.install(|| {
-        if scene.dim() == 3 && scene.discretisation.is_random() {
-            let p = super::solid::prepare_random_solid(scene, &|_| {})?;
-            run_prepared(p, opts, threads, &build_simulation, &stress_3d)
-        } else if scene.dim() == 3 {
-            let p = super::solid::prepare_solid(scene, &|_| {})?;
-            run_prepared(p, opts, threads, &build_simulation, &stress_3d)
-        } else if slots_of(scene) == random::SLOTS_2D {
-            let p = prepare_with::<{ random::SLOTS_2D }>(scene, &|_| {})?;
-            run_prepared(p, opts, threads, &build_simulation, &stress_2d)
-        } else {
-            run_prepared(
-                prepare_with::<6>(scene, &|_| {})?,
-                opts,
-                threads,
-                &build_simulation,
-                &stress_2d,
-            )
-        }
-    })
+    pool.install(|| dispatch(scene, Execute { opts, threads }))
+}
+
+/// A run of a scene with its generator.
+struct Execute<'a> {
+    opts: &'a RunOptions,
+    threads: usize,
+}
+
+impl TypedRun for Execute<'_> {
+    type Output = Result<Outcome, RunError>;
+
+    fn run<G, const D: usize, const K: usize>(self, scene: &Scene, generator: G) -> Self::Output
+    where
+        G: Generator<D, K>,
+        Dim<D>: Dimension<D> + Recover<D>,
+    {
+        let p = prepare(scene, generator)?;
+        run_prepared(
+            p,
+            self.opts,
+            self.threads,
+            &build_simulation,
+            &Dim::<D>::recover,
+        )
+    }
 }
 
 /// The simulation of a prepared scene (2D or 3D), at rest, taking over the model's arrays (no
@@ -119,54 +127,6 @@ pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> 
         std::mem::take(&mut p.model.mech),
         std::mem::take(&mut p.model.prescribed),
         integration,
-    )
-}
-
-/// What a run shows of each particle at its end: the stress (6 Voigt components) and, with
-/// damage, each particle's damage.
-type Recovered = (Vec<[f64; 6]>, Option<Vec<ParticleDamage>>);
-
-/// The recovered stress D_i·ε_i of a 2D run (run::stress_recovery), not (3.18).
-fn stress_2d<const K: usize>(p: &Prepared<K>, sim: &Simulation<2, K>) -> Recovered {
-    let x = &sim.state.x;
-    let (stress, damage) = match &sim.inelastic {
-        Some(model) => {
-            let damage = model.damage();
-            let intact = |j: usize| {
-                let d = &damage[j];
-                d.wt == 0.0 && d.wc == 0.0 && !d.yielded
-            };
-            let strain = stress_recovery::recovered_strain(
-                &p.model,
-                x,
-                model.particle_strain(&sim.mech, x),
-                &intact,
-            );
-            (
-                stress_recovery::recovered_stress(&p.model, &strain),
-                Some(damage),
-            )
-        }
-        None => (stress_recovery::elastic_stress(&p.model, x), None),
-    };
-    (stress.iter().map(voigt6).collect(), damage)
-}
-
-/// The stress of a 3D run: D·ε_i with ε_i each particle's least-squares strain of its own
-/// (damaged elastic) bond stretches (docs/model.md §7, §13), as in the bulk of 2D; with damage,
-/// each particle's damage.
-fn stress_3d<const K: usize>(p: &Prepared<K, 3>, sim: &Simulation<3, K>) -> Recovered {
-    let x = &sim.state.x;
-    let (strain, damage) = match &sim.inelastic {
-        Some(model) => (model.particle_strain(&sim.mech, x), Some(model.damage())),
-        None => (stress_recovery::elastic_strain(&p.model, x), None),
-    };
-    (
-        stress_recovery::stress_3d(&p.model, &strain)
-            .iter()
-            .map(voigt6)
-            .collect(),
-        damage,
     )
 }
 

@@ -1,8 +1,9 @@
 //! `run(scene) -> Outcome`: the whole pipeline of one specimen (docs/architecture.md), in three
 //! stages that run one way:
 //!
-//! 1. [`prepare`]: scene → body (discretisation, groups, supports, micro-moduli, random
-//!    fields) → model → T1, dampers and the stable time step;
+//! 1. [`dispatch`] picks the scene's generator ([`generate`]: discretisation, groups,
+//!    supports, micro-moduli, random fields → [`Model`]); [`prepare`] adds T1, dampers and
+//!    the stable time step;
 //! 2. [`execute`]: the explicit or relaxation run with probes, to an [`Outcome`];
 //! 3. [`summary`]: what the run measured, as summary.json reports it.
 //!
@@ -10,18 +11,21 @@
 //! displacements, 6-component stresses), so one set of reports serves 2D and 3D. The CLI and
 //! the studies are thin callers.
 
+pub mod dispatch;
 pub mod execute;
+pub mod generate;
+pub mod model;
 pub mod prepare;
-pub mod solid;
+pub mod recover;
 pub mod stress_recovery;
 pub mod summary;
 
 pub use crate::limits::available_memory;
+pub use dispatch::{dispatch, estimated_memory, TypedRun};
 pub use execute::{build_simulation, particle_stress, run};
-pub use prepare::{
-    estimated_memory, estimated_particles, prepare, prepare_model, prepare_model_with,
-    prepare_with, Model, Prepared, SurfaceCorrection,
-};
+pub use generate::{Fcc, Generator, Hexagonal, RandomPlane, RandomSolid};
+pub use model::{estimated_particles, Model, SurfaceCorrection};
+pub use prepare::{prepare, prepare_model, prepare_model_with, prepare_with, Prepared};
 pub use summary::{Outcome, Summary};
 
 use crate::scene::SceneError;

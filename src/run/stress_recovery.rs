@@ -29,7 +29,7 @@
 //!
 //! (3.18) stays available as `run::particle_stress`.
 
-use super::prepare::Model;
+use super::model::Model;
 use crate::discretise::NONE;
 use crate::material::properties;
 use crate::model::dimension::{Dim, Dimension};

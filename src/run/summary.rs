@@ -1,7 +1,8 @@
 //! Stage 3 of a run: what it measured (summary.json) and the dimension-erased outcome handed
 //! to `output` and `study`.
 
-use super::prepare::{Prepared, SurfaceCorrection};
+use super::model::{ModuliFit, SurfaceCorrection};
+use super::prepare::Prepared;
 use crate::discretise::groups;
 use crate::material::properties::{FieldReport, SampledField};
 use crate::scene::{Scene, SolverMethod};
@@ -118,7 +119,7 @@ pub struct Summary {
 #[derive(Clone, Debug, Serialize)]
 pub struct RandomReport {
     pub generation: crate::discretise::random::Generation,
-    pub micro_moduli: super::prepare::ModuliFit,
+    pub micro_moduli: ModuliFit,
 }
 
 /// What a run produces, dimension-erased: points and displacements as 3-vectors (z = 0 in

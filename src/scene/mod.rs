@@ -280,10 +280,9 @@ impl CutoutSpec {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DiscretisationSpec {
-    /// "hexagonal" (2D SPLM) or "random" (SPPM: random Voronoi-weighted particles,
-    /// `discretise::random`).
-    #[serde(default = "default_lattice")]
-    pub lattice: String,
+    /// The particles the body is filled with ([`Lattice`]; default hexagonal).
+    #[serde(default)]
+    pub lattice: Lattice,
     /// Nearest-neighbour spacing L0 (m); for random particles the mean spacing: the particle
     /// density of a hexagonal lattice of this L0.
     pub spacing: f64,
@@ -307,6 +306,64 @@ pub struct DiscretisationSpec {
     /// other.
     #[serde(default)]
     pub surface_correction: Option<bool>,
+}
+
+/// The particles a body is filled with (`discretisation.lattice`); with the body's kind it
+/// decides the [`Discretisation`] a scene runs with.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Lattice {
+    /// The hexagonal close-packed lattice (2D SPLM).
+    #[default]
+    Hexagonal,
+    /// The face-centred cubic lattice (3D SPLM).
+    Fcc,
+    /// Random Voronoi-weighted particles (SPPM), in a 2D shape or a solid.
+    Random,
+}
+
+impl Lattice {
+    /// The name a scene gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Lattice::Hexagonal => "hexagonal",
+            Lattice::Fcc => "fcc",
+            Lattice::Random => "random",
+        }
+    }
+}
+
+/// The discretisation a scene runs with: the lattice in the body's dimension. It fixes the
+/// dimension and the bond slots of the run (`run::dispatch`, the one place a scene becomes a
+/// typed run).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Discretisation {
+    /// The hexagonal lattice in a 2D shape: 6 slots.
+    Hexagonal,
+    /// Random particles in a 2D shape.
+    RandomPlane,
+    /// The FCC lattice in a solid: 18 slots.
+    Fcc,
+    /// Random particles in a solid.
+    RandomSolid,
+}
+
+impl Discretisation {
+    /// The spatial dimension of its runs.
+    pub fn dim(self) -> usize {
+        match self {
+            Discretisation::Hexagonal | Discretisation::RandomPlane => 2,
+            Discretisation::Fcc | Discretisation::RandomSolid => 3,
+        }
+    }
+
+    /// Whether its particles are random (SPPM).
+    pub fn is_random(self) -> bool {
+        matches!(
+            self,
+            Discretisation::RandomPlane | Discretisation::RandomSolid
+        )
+    }
 }
 
 /// A lattice's rotation (`discretisation.rotation_deg`): one angle (2D, or about z in 3D) or
@@ -389,6 +446,11 @@ impl Surface {
             Surface::LatticeFit => "lattice_fit",
         }
     }
+
+    /// Whether boundary particles get micro-moduli fitted by least squares.
+    pub fn fits(self) -> bool {
+        matches!(self, Surface::VoronoiFit | Surface::LatticeFit)
+    }
 }
 
 impl DiscretisationSpec {
@@ -404,7 +466,7 @@ impl DiscretisationSpec {
 
     /// Whether the body is random particles (SPPM) rather than a lattice.
     pub fn is_random(&self) -> bool {
-        self.lattice == "random"
+        self.lattice == Lattice::Random
     }
 
     /// The offset in the plane (2D; validated to have two components).
@@ -422,9 +484,6 @@ impl DiscretisationSpec {
     }
 }
 
-fn default_lattice() -> String {
-    "hexagonal".into()
-}
 fn default_true() -> bool {
     true
 }
@@ -1003,14 +1062,23 @@ fn default_field() -> Field {
 }
 
 impl Scene {
+    /// The discretisation the scene runs with: the FCC lattice, or random particles in a
+    /// solid (box, cylinder, prism), are 3D; the hexagonal lattice and random particles in a
+    /// 2D shape are 2D. (An FCC lattice in a 2D shape, or a hexagonal one in a solid, is
+    /// refused by validation.)
+    pub fn discretisation(&self) -> Discretisation {
+        match (self.discretisation.lattice, self.body.is_solid()) {
+            (Lattice::Fcc, _) => Discretisation::Fcc,
+            (Lattice::Random, true) => Discretisation::RandomSolid,
+            (Lattice::Random, false) => Discretisation::RandomPlane,
+            (Lattice::Hexagonal, _) => Discretisation::Hexagonal,
+        }
+    }
+
     /// The spatial dimension: 3 for the FCC lattice and for random particles in a solid
     /// (box, cylinder, prism), 2 otherwise.
     pub fn dim(&self) -> usize {
-        match self.discretisation.lattice.as_str() {
-            "fcc" => 3,
-            "random" if self.body.is_solid() => 3,
-            _ => 2,
-        }
+        self.discretisation().dim()
     }
 
     /// Parse TOML text, apply `key=value` overrides, and validate.

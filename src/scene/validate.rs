@@ -86,13 +86,6 @@ impl Scene {
         self.validate_cutouts()?;
         super::random_fields::check(self)?;
         let d = &self.discretisation;
-        if !["hexagonal", "random", "fcc"].contains(&d.lattice.as_str()) {
-            return Err(invalid(
-                "discretisation.lattice",
-                format!("{:?}", d.lattice),
-                "\"hexagonal\" (2D SPLM), \"random\" (SPPM: random Voronoi-weighted particles, 2D or in a solid body) or \"fcc\" (3D SPLM)",
-            ));
-        }
         if d.is_random() {
             if let Some(f) = d.min_distance {
                 if !(f.is_finite() && (0.5..=0.75).contains(&f)) {

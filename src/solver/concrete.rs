@@ -386,7 +386,7 @@ where
 /// +9 to +22%: benchmarks/RESULTS.md, "Concrete kernels: a two-field slot cache"). The cache
 /// is laid out in blocks of [`LANES`] particles, each field of a slot four lanes wide
 /// ([`slot_cache_at`]), so that the AVX passes load and store it a vector at a time
-/// (benchmarks/RESULTS.md, "Sixth attempt").
+/// (benchmarks/RESULTS.md, "Slot cache and pass 2 of the concrete kernels").
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SlotCache {
     d_a_se: f64,

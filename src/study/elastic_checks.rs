@@ -3,7 +3,7 @@
 //! They measure how a discretisation's boundary particles carry stiffness
 //! (`discretisation.surface`; tests/surfaces.rs, benchmarks/surfaces.rs).
 
-use crate::run::{prepare_model, Model, RunError};
+use crate::run::{prepare_model, Hexagonal, Model, RunError};
 use crate::scene::Scene;
 use crate::solver::linear::LinearOperator;
 use crate::solver::modal::{static_force_response, static_response};
@@ -58,7 +58,7 @@ pub fn cantilever_scene(h: f64, length: f64, p: &Placement) -> Result<Scene, Run
 /// load-weighted mean (work-conjugate) deflection, and Timoshenko's δ = P·L³/(3EI) +
 /// P·L/(κGA) (κ = 5/6) with L the load's centroid. Returns (ratio, model).
 pub fn cantilever_stiffness(h: f64, length: f64, p: &Placement) -> Result<(f64, Model), RunError> {
-    let model = prepare_model(&cantilever_scene(h, length, p)?)?;
+    let model = prepare_model(&cantilever_scene(h, length, p)?, Hexagonal)?;
     let x0 = &model.particles.x0;
     let vol = &model.particles.volume;
     let tip: Vec<usize> = (0..x0.len())
@@ -97,7 +97,7 @@ pub fn plate_scene(width: f64, height: f64, p: &Placement) -> Result<Scene, RunE
 /// σ = F/(W·t) from the reaction of the pulled rows, the strains from an affine fit of the
 /// displacements over the middle half of the plate.
 pub fn plate_modulus(width: f64, height: f64, p: &Placement) -> Result<(f64, f64), RunError> {
-    let model = prepare_model(&plate_scene(width, height, p)?)?;
+    let model = prepare_model(&plate_scene(width, height, p)?, Hexagonal)?;
     let (u, force) = pulled(&model)?;
     let x0 = &model.particles.x0;
     // affine fit u ≈ G·x + c over the middle half
@@ -170,7 +170,7 @@ pub struct HoleStress {
 /// Solve the plate with a hole statically and read [`HoleStress`].
 pub fn hole_stress(width: f64, radius: f64, p: &Placement) -> Result<HoleStress, RunError> {
     use crate::run::stress_recovery::elastic_stress;
-    let model = prepare_model(&hole_plate_scene(width, radius, p)?)?;
+    let model = prepare_model(&hole_plate_scene(width, radius, p)?, Hexagonal)?;
     let n = model.particles.len();
     let (u, force) = pulled(&model)?;
     let remote = force / (width * THICKNESS);
@@ -213,7 +213,7 @@ pub fn hole_stress(width: f64, radius: f64, p: &Placement) -> Result<HoleStress,
 /// free; σ = F/W² from the reaction of the pulled particles, ε_zz and the lateral strains
 /// (mean of ε_xx and ε_yy) from an affine fit of the displacements over the middle half of
 /// the block. `surface` as `discretisation.surface` of a 3D scene
-/// (`run::solid::surface_treatment`: "voronoi_fit" clips the cells to the box).
+/// (`run::generate::fcc_surface_treatment`: "voronoi_fit" clips the cells to the box).
 pub fn fcc_block_modulus(
     width: f64,
     height: f64,
@@ -221,7 +221,7 @@ pub fn fcc_block_modulus(
     surface: crate::scene::Surface,
 ) -> Result<(f64, f64), RunError> {
     use crate::geometry::Shape3;
-    use crate::run::solid::surface_treatment;
+    use crate::run::generate::fcc_surface_treatment as surface_treatment;
     let shape = Shape3::Box {
         origin: Vector3::zeros(),
         size: Vector3::new(width, width, height),
@@ -252,7 +252,7 @@ pub fn random_block_modulus(
     let (mut p, _) = random3::fill::<SLOTS_3D>(&shape, recipe).map_err(RunError::Setup)?;
     let d = <Dim<3> as Dimension<3>>::elasticity(E * e_fit, nu_fit, crate::scene::Plane::Stress);
     let (mut a, mut b) = (vec![0.0; p.len()], vec![0.0; p.len()]);
-    let fit = crate::run::prepare::fit_moduli_3d(&p, &d, &mut a, &mut b);
+    let fit = crate::run::generate::moduli::fit_moduli_3d(&p, &d, &mut a, &mut b);
     if fit.unfitted > 0 {
         return Err(RunError::Setup(format!(
             "{} random particles have no moduli fit",

@@ -1,0 +1,205 @@
+//! The assembled elastic model of a scene, whatever its discretisation: the body's particles,
+//! groups, supports and micro-moduli ([`Model`]), what the boundary treatment did, and the
+//! size checks made before anything is allocated.
+
+use super::RunError;
+use crate::discretise::random::Generation;
+use crate::discretise::{bytes_per_particle, groups, Particles};
+use crate::limits::available_memory;
+use crate::material::properties::SampledField;
+use crate::model::micro_modulus::MicroModuli;
+use crate::scene::Scene;
+use crate::solver::loading::Prescribed;
+use crate::solver::mechanics::Mechanics;
+use nalgebra::Vector2;
+use serde::Serialize;
+
+/// How the lattice's boundary particles were weighted (`discretisation.surface`; docs/model.md §1,
+/// §3): their count, the fits, and the body's volume against the particles'.
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceCorrection {
+    /// `discretisation.surface` ("voronoi_fit", "voronoi", "lattice", "lattice_fit";
+    /// "voronoi_fit" for random particles, which fit every particle).
+    pub method: &'static str,
+    /// Whether boundary particles got fitted micro-moduli.
+    pub enabled: bool,
+    /// Particles with fewer than six bonds or a clipped cell.
+    pub boundary_particles: usize,
+    /// Boundary particles given fitted constants.
+    pub corrected: usize,
+    /// Boundary particles whose bonds cannot carry a fit (kept at bulk constants, scaled by
+    /// their volume fraction under a "voronoi" method).
+    pub kept_bulk: usize,
+    /// Largest ‖a·A + b·B − D‖/‖D‖ among the corrected particles.
+    pub max_residual: f64,
+    /// The body's volume (area × thickness, m³) and the particles' total ΔV.
+    pub body_volume: f64,
+    pub particle_volume: f64,
+}
+
+/// What a random body (SPPM) adds to the model: its Voronoi cells, what generation
+/// measured, and how well each particle's fitted micro-moduli reproduce D.
+#[derive(Clone, Debug)]
+pub struct RandomBody {
+    /// Each particle's Voronoi cell clipped to the body (counter-clockwise polygon, m).
+    pub cells: Vec<Vec<Vector2<f64>>>,
+    pub generation: Generation,
+    pub moduli: ModuliFit,
+}
+
+/// The per-particle least-squares micro-moduli of a random body (docs/model.md §3, (3.20)).
+#[derive(Clone, Debug, Serialize)]
+pub struct ModuliFit {
+    /// ‖a_i·A_i + b_i·B_i − D‖/‖D‖ of each particle (NaN where no fit exists).
+    #[serde(skip)]
+    pub residual: Vec<f64>,
+    pub residual_mean: f64,
+    pub residual_p99: f64,
+    pub residual_max: f64,
+    /// Particles whose bonds cannot carry a fit (too few, or too nearly collinear, or a fit
+    /// with a ≤ 0): they keep the hexagonal lattice's constants at their own length.
+    pub unfitted: usize,
+}
+
+/// The assembled elastic model of a scene, before any dynamics (T1, dampers, time step), in
+/// `K` bond slots (6: the hexagonal lattice; [`random::SLOTS_2D`]: random particles).
+pub struct Model<const K: usize = 6, const D: usize = 2> {
+    pub scene: Scene,
+    pub particles: Particles<D, K>,
+    pub groups: Vec<groups::Group>,
+    pub prescribed: Vec<Prescribed>,
+    pub constrained: Vec<[bool; D]>,
+    pub mech: Mechanics<D, K>,
+    pub bulk: MicroModuli,
+    pub surface: SurfaceCorrection,
+    /// The scene's random fields sampled at the particles (docs/model.md §12).
+    pub fields: Vec<SampledField>,
+    /// Random particles only: cells, generation, fitted moduli.
+    pub random: Option<RandomBody>,
+}
+
+/// Particles the body will hold (area / cell area; in 3D volume / cell volume), known
+/// before anything is allocated.
+pub fn estimated_particles(scene: &Scene) -> f64 {
+    let l0 = scene.discretisation.spacing;
+    if let Some(solid) = scene.solid() {
+        return solid.volume() / crate::discretise::fcc::cell_volume(l0);
+    }
+    scene.shape().area() / (0.5 * 3f64.sqrt() * l0 * l0)
+}
+
+/// Estimated bytes a run of the scene allocates in `slots` bond slots (2D or 3D; with
+/// `[concrete]`, the damage kernel's too).
+pub fn memory_in_slots(scene: &Scene, slots: usize) -> f64 {
+    let dim = scene.dim();
+    let damage = if scene.concrete.is_some() {
+        crate::solver::concrete::bytes_per_particle(dim, slots)
+    } else {
+        0
+    };
+    estimated_particles(scene) * (bytes_per_particle(dim, slots) + damage) as f64
+}
+
+/// Refuse a scene whose body would not fit this machine's memory (80% of what is available)
+/// or that has more particles than a run can index, before anything is allocated; `slots`
+/// are the bond slots of its discretisation.
+pub(crate) fn check_size(scene: &Scene, slots: usize) -> Result<(), RunError> {
+    let d = &scene.discretisation;
+    let need = memory_in_slots(scene, slots);
+    if let Some(avail) = available_memory() {
+        if need > 0.8 * avail as f64 {
+            return Err(RunError::Setup(format!(
+                "discretisation.spacing = {}: the body would hold about {:.3e} particles needing about {:.1} GiB, more than this machine has available ({:.1} GiB); use a larger spacing",
+                d.spacing,
+                estimated_particles(scene),
+                need / 2f64.powi(30),
+                avail as f64 / 2f64.powi(30)
+            )));
+        }
+    }
+    if estimated_particles(scene) > u32::MAX as f64 / 2.0 {
+        return Err(RunError::Setup(format!(
+            "discretisation.spacing = {}: about {:.3e} particles, more than the 2.1e9 a run can index",
+            d.spacing,
+            estimated_particles(scene)
+        )));
+    }
+    Ok(())
+}
+
+/// The error of a ν outside the range random particles' elastic calibration covers
+/// (`allowed` names the range).
+pub(crate) fn nu_outside_calibration(nu: f64, allowed: String) -> RunError {
+    RunError::Scene(crate::scene::SceneError::Invalid {
+        key: "material.nu".into(),
+        value: nu.to_string(),
+        allowed,
+    })
+}
+
+/// The scene's groups on a body, its supports (`constrained`) and its prescribed
+/// displacements; `select` picks a selection's members, `extent` describes the body for the
+/// message of a selection that picks nothing.
+#[allow(clippy::type_complexity)]
+pub(crate) fn supports<const D: usize, const K: usize>(
+    scene: &Scene,
+    particles: &Particles<D, K>,
+    select: &dyn Fn(&crate::scene::Selection) -> Vec<u32>,
+    extent: &str,
+) -> Result<(Vec<groups::Group>, Vec<[bool; D]>, Vec<Prescribed>), RunError> {
+    let n = particles.len();
+    let mut groups = Vec::new();
+    let mut constrained = vec![[false; D]; n];
+    let mut amplitude: Vec<[Option<(f64, String)>; D]> = vec![std::array::from_fn(|_| None); n];
+    for g in &scene.groups {
+        let members = select(&g.select);
+        if members.is_empty() {
+            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                key: format!("groups.{}.select", g.name),
+                value: g.select.scene_text(),
+                allowed: format!(
+                    "a selection that contains at least one particle; the body spans {extent}"
+                ),
+            }));
+        }
+        let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
+        if let Some(l) = &g.load {
+            entries.push((l.component.index(), l.delta()));
+        }
+        for &i in &members {
+            for &(c, amp) in &entries {
+                let slot = &mut amplitude[i as usize][c];
+                match slot {
+                    Some((prev, other)) if *prev != amp => {
+                        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                            key: format!("groups.{}", g.name),
+                            value: format!("particle {i} at {:?}", particles.x0[i as usize].as_slice()),
+                            allowed: format!(
+                                "groups that overlap must prescribe the same displacement: groups.{other} already prescribes {prev} m in component {c}, this group {amp} m"
+                            ),
+                        }))
+                    }
+                    _ => *slot = Some((amp, g.name.clone())),
+                }
+                constrained[i as usize][c] = true;
+            }
+        }
+        groups.push(groups::Group {
+            name: g.name.clone(),
+            members,
+        });
+    }
+    let prescribed: Vec<Prescribed> = (0..n)
+        .flat_map(|i| {
+            let a = amplitude[i].clone();
+            (0..D).filter_map(move |c| {
+                a[c].as_ref().map(|(amp, _)| Prescribed {
+                    particle: i as u32,
+                    component: c as u8,
+                    amplitude: *amp,
+                })
+            })
+        })
+        .collect();
+    Ok((groups, constrained, prescribed))
+}

@@ -1,0 +1,38 @@
+//! The fast test suite: one test crate (one link) whose modules mirror the topics of src/.
+//! The long physics validations are the `validation` target (`cargo test --release --test validation`).
+
+mod cli;
+#[path = "../common/mod.rs"]
+mod common;
+mod concrete;
+mod concrete_3d;
+mod concrete_input;
+mod csr_layout;
+mod cutouts;
+mod damage_law;
+mod elastic_plate;
+mod fcc;
+mod fcc_kernel;
+mod force_law;
+mod fuzz_cli;
+mod golden;
+mod layering;
+mod montecarlo;
+mod patch_and_newton;
+mod proptest_scenes;
+mod quasi_static;
+mod random_field;
+mod random_field_scene;
+mod relaxation;
+mod reliability;
+mod reliability_studies;
+mod run_plate;
+mod scene_errors;
+mod specimens;
+mod sppm3d;
+mod sppm_concrete;
+mod sppm_elastic;
+mod stability;
+mod studies;
+mod surfaces;
+mod vibration_and_stability;
