@@ -1,7 +1,6 @@
 //! `sppm bench`: throughput of the step kernels (elastic; tension: tensile damage only; full:
 //! two-spring damage and plasticity) on a square block of hexagonal lattice, in particle-steps
-//! per second (set-up excluded). The elastic kernel runs on either bond layout: the fixed
-//! slots of the lattice (`solver::kernel`) or compressed sparse rows (`solver::csr_kernel`).
+//! per second (set-up excluded), on the fixed bond slots of the lattice (`solver::kernel`).
 //!
 //! `--dim 3` times the elastic slot kernel on a cube of FCC lattice (18 slots: 12 nearest
 //! and 6 second neighbours with the modulus a + c, docs/model.md §3 with its erratum), built by
@@ -9,15 +8,13 @@
 //! (benchmarks/fcc_vs_lammps.sh). The lattice generator `discretise::fcc` had not landed when
 //! this was written; the block needs no clipping to a shape.
 
-use crate::discretise::csr::Csr;
 use crate::discretise::hex::HexLattice;
 use crate::discretise::random::{self, RandomParticles};
 use crate::discretise::Particles;
 use crate::geometry::Shape2;
 use crate::model::micro_modulus;
 use crate::scene::Plane;
-use crate::solver::concrete::Inelastic;
-use crate::solver::csr_kernel;
+use crate::solver::inelastic::Inelastic;
 use crate::solver::kernel::{self, State};
 use crate::solver::mechanics::Mechanics;
 use crate::solver::KernelSet;
@@ -32,8 +29,6 @@ pub struct BenchResult {
     pub steps: usize,
     pub threads: usize,
     pub model: String,
-    /// Bond layout: "slots" or "csr".
-    pub layout: String,
     pub particle_steps_per_s: f64,
     pub seconds: f64,
     /// "hexagonal", "random" or "fcc".
@@ -85,48 +80,21 @@ fn fitted<const D: usize, const K: usize>(
     })
 }
 
-/// Bond layout of a benchmark.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Layout {
-    /// K fixed neighbour slots per particle (`discretise::Particles`, `solver::kernel`).
-    Slots,
-    /// Compressed sparse rows (`discretise::csr::Csr`, `solver::csr_kernel`): elastic only.
-    Csr,
-}
-
-impl Layout {
-    /// The value of `--layout`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Layout::Slots => "slots",
-            Layout::Csr => "csr",
-        }
-    }
-
-    /// Parse `--layout`.
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "slots" => Some(Layout::Slots),
-            "csr" => Some(Layout::Csr),
-            _ => None,
-        }
-    }
-}
-
 /// Bytes per particle a benchmark of `kernel` in `dim` dimensions allocates: the run's arrays
 /// ([`crate::discretise::bytes_per_particle`], with the lattice's slots) and, with damage,
-/// the damage kernel's ([`crate::solver::concrete::bytes_per_particle`]).
+/// the damage kernel's ([`crate::solver::inelastic::bytes_per_particle`]).
 pub fn bytes_per_particle(kernel: KernelSet, dim: usize) -> usize {
     let base = crate::discretise::bytes_per_particle(dim, crate::discretise::slots(dim));
     match kernel {
         KernelSet::Elastic => base,
-        _ => base + crate::solver::concrete::bytes_per_particle(dim, crate::discretise::slots(dim)),
+        _ => {
+            base + crate::solver::inelastic::bytes_per_particle(dim, crate::discretise::slots(dim))
+        }
     }
 }
 
 /// Time `steps` steps of `kernel` (bond dampers on, as in the shipped scenes) on a square
-/// block of about `particles` particles on `threads` threads, with the bonds in `layout`
-/// (the CSR layout runs the elastic kernel only). The tension and full kernels
+/// block of about `particles` particles on `threads` threads. The tension and full kernels
 /// run the Table 1 concrete of Nikravesh Kazeroni (2017) under an equibiaxial strain of 0.9e-4 (1.03·f't/E; the
 /// principal stress E·ε/(1 − ν) is 1.29·f't), so every particle initiates in the first
 /// step and then softens: each timed step evaluates every particle's tensile damage (and,
@@ -137,16 +105,9 @@ pub fn bench(
     steps: usize,
     threads: usize,
     kernel: KernelSet,
-    layout: Layout,
     lattice: &str,
     simd: bool,
 ) -> anyhow::Result<BenchResult> {
-    anyhow::ensure!(
-        layout == Layout::Slots || kernel == KernelSet::Elastic,
-        "--layout {}: the {} kernel runs on \"slots\" only; \"csr\" runs --model elastic",
-        layout.name(),
-        kernel.name()
-    );
     let l0 = 1e-3;
     let side = (particles as f64 * 0.5 * 3f64.sqrt()).sqrt() * l0;
     let shape = Shape2::Rectangle {
@@ -167,14 +128,9 @@ pub fn bench(
             let mm = micro_modulus::hexagonal(30e9, 0.2, l0, 0.1, Plane::Stress);
             p.a = vec![mm.a; n];
             p.b = vec![mm.b; n];
-            time_steps(p, steps, threads, kernel, layout, None, simd)
+            time_steps(p, steps, threads, kernel, None, simd)
         }
         "random" => {
-            anyhow::ensure!(
-                layout == Layout::Slots,
-                "--layout {}: random particles run on \"slots\"",
-                layout.name()
-            );
             let recipe = RandomParticles {
                 spacing: l0,
                 min_distance: random::DEFAULT_MIN_DISTANCE,
@@ -188,7 +144,7 @@ pub fn bench(
             let setup = fitted(&mut p, &g, |p, a, b| {
                 crate::run::generate::moduli::fit_moduli(p, &d, a, b)
             })?;
-            time_steps(p, steps, threads, kernel, layout, Some(setup), simd)
+            time_steps(p, steps, threads, kernel, Some(setup), simd)
         }
         other => anyhow::bail!("--lattice {other}: \"hexagonal\" or \"random\""),
     }
@@ -227,13 +183,13 @@ fn damage_model<const D: usize, const K: usize>(
     p: &crate::discretise::Particles<D, K>,
     kernel: KernelSet,
     simd: bool,
-) -> anyhow::Result<Option<crate::solver::concrete::Concrete<D, K>>>
+) -> anyhow::Result<Option<crate::solver::inelastic::DamageKernel<D, K>>>
 where
     crate::model::dimension::Dim<D>: crate::model::dimension::Dimension<D>,
 {
     let model = (kernel != KernelSet::Elastic).then(|| {
         let law = crate::model::damage::ConcreteLaw::table1(kernel == KernelSet::Full);
-        let mut c = crate::solver::concrete::Concrete::<D, K>::new(
+        let mut c = crate::solver::inelastic::DamageKernel::<D, K>::new(
             crate::model::two_spring::TwoSpring::new(law, None),
             p,
         );
@@ -254,7 +210,6 @@ fn time_steps<const K: usize>(
     steps: usize,
     threads: usize,
     kernel: KernelSet,
-    layout: Layout,
     setup: Option<Setup>,
     simd: bool,
 ) -> anyhow::Result<BenchResult> {
@@ -262,15 +217,10 @@ fn time_steps<const K: usize>(
     let (mech, mut st) = strained_model(&p, kernel);
     let dt = 0.9 * crate::solver::time_step::stable_step(&mech, &p.x0).dt_stable;
     let mut model = damage_model(&p, kernel, simd)?;
-    let csr = match layout {
-        Layout::Csr => Some(Csr::from_slots(&p).map_err(|e| anyhow::anyhow!("CSR bonds: {e}"))?),
-        Layout::Slots => None,
-    };
     let mut one_step = |st: &mut State<2>| {
-        match (model.as_mut(), &csr) {
-            (Some(c), _) => c.step(&mech, st, dt, false, true),
-            (None, Some(csr)) => csr_kernel::step::<2, K, false, true>(csr, &mech, st, dt),
-            (None, None) => kernel::step::<2, K, false, true>(&mech, st, dt),
+        match model.as_mut() {
+            Some(c) => c.step(&mech, st, dt, false, true),
+            None => kernel::step::<2, K, false, true>(&mech, st, dt),
         }
         std::mem::swap(&mut st.x, &mut st.x_next);
         std::mem::swap(&mut st.v, &mut st.v_next);
@@ -293,7 +243,6 @@ fn time_steps<const K: usize>(
         steps,
         threads,
         model: kernel.name().into(),
-        layout: layout.name().into(),
         particle_steps_per_s: (n * steps) as f64 / seconds,
         seconds,
         lattice: if setup.is_some() {
@@ -395,7 +344,6 @@ pub fn bench_fcc(
         steps,
         threads,
         model: kernel.name().into(),
-        layout: Layout::Slots.name().into(),
         particle_steps_per_s: (n * steps) as f64 / seconds,
         seconds,
         lattice: "fcc".into(),
@@ -465,7 +413,6 @@ pub fn bench_random3(
         steps,
         threads,
         model: kernel.name().into(),
-        layout: Layout::Slots.name().into(),
         particle_steps_per_s: (n * steps) as f64 / seconds,
         seconds,
         lattice: "random".into(),

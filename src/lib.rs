@@ -14,11 +14,11 @@
 //! 1. [`scene`]: describes and validates a specimen; it imports nothing from the model, the
 //!    material or the solver;
 //! 2. [`discretise`] fills a body (positions, volumes, horizons, length scales, micro-moduli,
-//!    bonds in the slot or the CSR layout); [`model`] is the constitutive law: the force law
+//!    bonds in fixed slots); [`model`] is the constitutive law: the force law
 //!    ([`model::force_state`]), dimension as a type ([`model::dimension`]), damage laws behind
 //!    a trait ([`model::damage_law`]). The two do not import each other;
 //! 3. [`material`]: properties per particle (random fields sampled on a body);
-//! 4. [`solver`]: step kernels (slot, CSR, concrete generic over law and dimension), time
+//! 4. [`solver`]: step kernels (elastic, and inelastic generic over law and dimension), time
 //!    step, modal analysis, relaxation;
 //! 5. [`run`]: prepare → execute → summary, ending in a dimension-erased [`run::Outcome`];
 //! 6. [`output`]: the reports of an outcome;

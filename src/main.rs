@@ -60,10 +60,6 @@ enum Command {
         /// plasticity; "concrete" is accepted for it).
         #[arg(long, default_value = "elastic")]
         model: String,
-        /// Bond layout: "slots" (fixed neighbour slots) or "csr" (compressed sparse rows;
-        /// --model elastic only).
-        #[arg(long, default_value = "slots")]
-        layout: String,
         /// Particles: "hexagonal" (the lattice) or "random" (SPPM; slots only; the set-up
         /// times of placement, Voronoi cells, bonds and moduli are reported too).
         #[arg(long, default_value = "hexagonal")]
@@ -192,7 +188,6 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             steps,
             threads,
             model,
-            layout,
             lattice,
             scalar,
         } => {
@@ -212,22 +207,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 !scalar || kernel != sppm::solver::KernelSet::Elastic,
                 "--scalar: the scalar path of the damage kernels (--model tension or full); the elastic kernel has no switch"
             );
-            let layout = sppm::bench::Layout::parse(&layout).ok_or_else(|| {
-                anyhow::anyhow!("--layout {layout}: \"slots\" or \"csr\" (elastic only)")
-            })?;
-            anyhow::ensure!(
-                layout == sppm::bench::Layout::Slots
-                    || kernel == sppm::solver::KernelSet::Elastic,
-                "--layout {}: runs --model elastic only, not --model {model}; use --layout slots for the {} kernel",
-                layout.name(),
-                kernel.name()
-            );
             if dim == 3 {
-                anyhow::ensure!(
-                    layout == sppm::bench::Layout::Slots,
-                    "--layout {} with --dim 3: the FCC lattice runs on \"slots\"",
-                    layout.name()
-                );
                 anyhow::ensure!(
                     ["hexagonal", "fcc", "random"].contains(&lattice.as_str()),
                     "--lattice {lattice} with --dim 3: \"fcc\" (the FCC lattice) or \"random\" (random particles, elastic kernel)"
@@ -250,15 +230,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             } else if dim == 3 {
                 sppm::bench::bench_fcc(particles, steps.max(1), threads, kernel, !scalar)
             } else {
-                sppm::bench::bench(
-                    particles,
-                    steps.max(1),
-                    threads,
-                    kernel,
-                    layout,
-                    &lattice,
-                    !scalar,
-                )
+                sppm::bench::bench(particles, steps.max(1), threads, kernel, &lattice, !scalar)
             }
             .context("benchmark failed")?;
             say!("{}", serde_json::to_string(&r)?);

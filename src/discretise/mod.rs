@@ -2,14 +2,12 @@
 //! a horizon and a length scale each, their micro-moduli, and bonds with their own reference
 //! length; and named groups of particles.
 //!
-//! Bonds come in two layouts. The fixed-slot layout of [`Particles`] is the fast path of the
-//! lattices (6 slots for the 2D hexagonal lattice, 18 for 3D FCC; an empty slot holds
-//! [`NONE`]); the compressed-row layout of `csr` serves a varying number of neighbours per
-//! particle (random particles). One container serves every dimension `D` and slot count `K`.
+//! Bonds sit in fixed slots ([`Particles`]): 6 for the 2D hexagonal lattice, 18 for 3D FCC,
+//! 12 and 36 for random particles in 2D and 3D; an empty slot holds [`NONE`]. One container
+//! serves every dimension `D` and slot count `K`.
 //! Everything downstream (micro-moduli, dampers, time step, crack band) reads a particle's
 //! own values from the body, never the scene's nominal spacing.
 
-pub mod csr;
 pub mod fcc;
 pub mod groups;
 pub mod hex;

@@ -171,6 +171,26 @@ impl Placed {
     }
 }
 
+/// The box, about the centre of the box (lo, hi), that holds it turned back by `rotation`:
+/// where the interior's candidates are drawn before they are turned into the body.
+fn turned_box(lo: P, hi: P, rotation: &nalgebra::Matrix3<f64>) -> (P, P) {
+    let centre = (lo + hi) * 0.5;
+    let inv = rotation.transpose();
+    let corners: Vec<P> = (0..8)
+        .map(|c| {
+            let v = P::new(
+                if c & 1 == 0 { lo.x } else { hi.x },
+                if c & 2 == 0 { lo.y } else { hi.y },
+                if c & 4 == 0 { lo.z } else { hi.z },
+            );
+            inv * (v - centre)
+        })
+        .collect();
+    corners
+        .iter()
+        .fold((corners[0], corners[0]), |(a, b), c| (a.inf(c), b.sup(c)))
+}
+
 /// Place the particles: the surface's edges and faces, then the interior; then sort them in
 /// rows. Returns the positions and how many lie on the surface. `Err` when the body cannot
 /// hold the density at this minimum distance.
@@ -271,21 +291,7 @@ pub fn place(shape: &Shape3, recipe: &RandomSolid) -> Result<(Vec<P>, usize), St
     let turned = recipe.rotation_deg.iter().any(|&a| a != 0.0);
     let centre = (lo + hi) * 0.5;
     let (flo, fhi) = if turned {
-        let inv = rotation.transpose();
-        let corners: Vec<P> = (0..8)
-            .map(|c| {
-                let v = P::new(
-                    if c & 1 == 0 { lo.x } else { hi.x },
-                    if c & 2 == 0 { lo.y } else { hi.y },
-                    if c & 4 == 0 { lo.z } else { hi.z },
-                );
-                inv * (v - centre)
-            })
-            .collect();
-        let f = corners
-            .iter()
-            .fold((corners[0], corners[0]), |(a, b), c| (a.inf(c), b.sup(c)));
-        (f.0, f.1)
+        turned_box(lo, hi, &rotation)
     } else {
         (lo, hi)
     };

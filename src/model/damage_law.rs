@@ -1,5 +1,5 @@
 //! Damage laws behind a trait (docs/model.md §6): what a material's damage and plasticity decide,
-//! apart from the kernel that moves the particles (`solver::concrete`).
+//! apart from the kernel that moves the particles (`solver::inelastic`).
 //!
 //! The kernel owns the kinematics: for each particle it computes, bond by bond, the total
 //! stretch S_T, the elastic stretch S_e = S_T − S_P (3.38), the damage factor d the law
@@ -28,7 +28,7 @@
 //!    factor is the two springs in series (3.37) of two damage variables per particle: pass 1
 //!    then runs four particles at once (SIMD).
 //!
-//! Then `run` builds `solver::concrete::Concrete::<K, YourLaw>::new(law, &body)` where it
+//! Then `run` builds `solver::inelastic::DamageKernel::<K, YourLaw>::new(law, &body)` where it
 //! builds the two-spring law today.
 
 use super::dimension::{Dim, Dimension};
@@ -94,7 +94,7 @@ where
     pub lengths: &'a [f64],
     /// The strain the criteria (initiation, yield) read instead of the particle's own damaged
     /// elastic strain, where the kernel averages it over the particle's neighbourhood
-    /// (random particles; `solver::concrete`); `None`: the particle's own.
+    /// (random particles; `solver::inelastic`); `None`: the particle's own.
     pub criteria_strain: Option<&'a crate::model::dimension::Tensor<D>>,
 }
 
@@ -132,7 +132,7 @@ where
     /// (d, √d) of a bond between particles in states `i` and `j` with elastic stretch
     /// `elastic_stretch`; `FULL` is the kernel running ([`Kernel::Full`]). The second must be
     /// `d.sqrt()` bit for bit: the kernel's pass 2 recomputes it so from d
-    /// (`solver::concrete::SlotCache`).
+    /// (`solver::inelastic::SlotCache`).
     fn bond_factor<const FULL: bool>(
         &self,
         i: &Self::State,
@@ -145,7 +145,7 @@ where
     /// S_e ≥ 0, w_c where S_e < 0 and `FULL` (0 otherwise), (1, 1) when both w are 0, and
     /// `model::damage::damage_factor` and its square root otherwise. A law that says so gets
     /// the kernel's SIMD pass 1, which evaluates that rule four bonds at once, bit for bit as
-    /// `bond_factor` would (`solver::concrete` tests it); the default, `false`, runs the scalar
+    /// `bond_factor` would (`solver::inelastic` tests it); the default, `false`, runs the scalar
     /// pass through `bond_factor`.
     const SERIES_DAMAGE: bool = false;
 

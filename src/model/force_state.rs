@@ -2,9 +2,9 @@
 //!
 //! Every caller computes bond forces, force states, the dilatation term and the stored
 //! energy through these functions: the scalar step kernels (`solver::kernel`,
-//! `solver::concrete`, the CSR kernel), the linearised operator (`solver::linear`), the
+//! `solver::inelastic`), the linearised operator (`solver::linear`), the
 //! eigenvalue bound (`solver::mechanics`), the energy (`solver::Simulation`) and the stress
-//! recovery (`run::particle_stress`, `solver::concrete::particle_stress`). The AVX path of the
+//! recovery (`run::particle_stress`, `solver::inelastic::particle_stress`). The AVX path of the
 //! slot layout (`solver::kernel::avx`) performs the same IEEE operations lane by lane and is
 //! tested bit-identical to them; `tests/force_law.rs` evaluates random configurations
 //! through every caller and finds them equal.
@@ -17,7 +17,7 @@
 //!   S_ji = S_ij;
 //! - with damage factor d (3.37) and elastic stretch S_e, the damaged force state
 //!   d·a_i·S_e + √d·bθ_i and bond force ½(d·(a_i + a_j)·S_e + √d·(bθ_i + bθ_j)), with
-//!   bθ_i = b_i·Σ_m √d_im·S_e,im (the decision of `solver::concrete`);
+//!   bθ_i = b_i·Σ_m √d_im·S_e,im (the decision of `solver::inelastic`);
 //! - stored energy U = ¼·Σ_i Σ_j L0,ij·S_ij·F_s,ij, so that ∂U/∂L_ij = F_b,ij.
 //!
 //! Without damage (d = 1) the damaged forms equal the elastic ones up to the order of the

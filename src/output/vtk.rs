@@ -59,7 +59,7 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
         }
     }
     if let Some(d) = &o.damage {
-        type Get = fn(&crate::solver::concrete::ParticleDamage) -> f64;
+        type Get = fn(&crate::solver::inelastic::ParticleDamage) -> f64;
         let scalars: [(&str, Get); 3] = [
             ("tensile_damage", |p| p.wt),
             ("compressive_damage", |p| p.wc),

@@ -3,6 +3,7 @@
 
 use super::dispatch::{dispatch, TypedRun};
 use super::generate::Generator;
+use super::model::Model;
 use super::prepare::{prepare, Prepared};
 use super::recover::{Recover, Recovered};
 use super::summary::{point3, summarise, Finished, Outcome, SolverReport};
@@ -14,7 +15,7 @@ use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
 use crate::scene::{Scene, SolverMethod};
-use crate::solver::concrete::Concrete;
+use crate::solver::inelastic::DamageKernel;
 use crate::solver::mechanics::{weighted, Mechanics};
 use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
 use nalgebra::{SMatrix, SVector};
@@ -102,15 +103,29 @@ where
     Dim<D>: Dimension<D>,
 {
     let mut sim = simulation_of(p);
-    if let Some(law) = crate::model::damage::ConcreteLaw::from_scene(&p.model.scene) {
-        let local = properties::local_properties(&p.model.fields, &law, p.model.particles.len());
-        let mut c: Concrete<D, K> = Concrete::new(TwoSpring::new(law, local), &p.model.particles);
-        if p.model.random.is_some() {
-            c = c.with_neighbourhood_criteria(&p.model.particles);
-        }
+    if let Some(c) = damage_kernel(&p.model) {
         sim.inelastic = Some(Box::new(c));
     }
     sim
+}
+
+/// The damage kernel of a model with `[concrete]`: the two-spring law with each particle's
+/// local properties (docs/model.md §12); random particles read their criteria over their
+/// neighbourhood. `None` without `[concrete]`.
+pub fn damage_kernel<const K: usize, const D: usize>(
+    model: &Model<K, D>,
+) -> Option<DamageKernel<D, K>>
+where
+    Dim<D>: Dimension<D>,
+{
+    let law = crate::model::damage::ConcreteLaw::from_scene(&model.scene)?;
+    let local = properties::local_properties(&model.fields, &law, model.particles.len());
+    let c = DamageKernel::new(TwoSpring::new(law, local), &model.particles);
+    Some(if model.random.is_some() {
+        c.with_neighbourhood_criteria(&model.particles)
+    } else {
+        c
+    })
 }
 
 /// The elastic simulation of a prepared scene (2D or 3D), at rest, taking over the model's
@@ -128,6 +143,61 @@ pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> 
         std::mem::take(&mut p.model.prescribed),
         integration,
     )
+}
+
+/// The settings of a relaxation or quasi-static run: the scene's increments and tolerances,
+/// and with `solver.control` the gauge's weights on the free displacements (refused where a
+/// group prescribes one of them).
+fn incremental_settings<const K: usize, const D: usize>(
+    p: &Prepared<K, D>,
+    sim: &Simulation<D, K>,
+) -> Result<relaxation::Settings, RunError> {
+    let s = &p.model.scene.solver;
+    let quasi_static = s.method == SolverMethod::QuasiStatic;
+    let settings = relaxation::Settings {
+        increments: s.increments,
+        tolerance: s.tolerance,
+        max_iterations: s.max_iterations(),
+        ramp: p.model.scene.loading.ramp,
+        stop_after_peak: p.model.scene.loading.stop_after_peak,
+        stop_unconverged: quasi_static.then(|| s.max_residual.unwrap_or(s.tolerance)),
+        control: s.control.as_ref().map(|c| {
+            let mut gauge = Vec::new();
+            for (name, sign) in [(&c.plus, 1.0), (&c.minus, -1.0)] {
+                let members = &p
+                    .model
+                    .groups
+                    .iter()
+                    .find(|g| &g.name == name)
+                    .expect("solver.control names a group (validated)")
+                    .members;
+                let w = sign / members.len() as f64;
+                gauge.extend(
+                    members
+                        .iter()
+                        .map(|&i| (D * i as usize + c.component.index(), w)),
+                );
+            }
+            relaxation::Control {
+                gauge,
+                opening: c.opening,
+            }
+        }),
+    };
+    if let Some(c) = &settings.control {
+        for p in &sim.prescribed {
+            let d = D * p.particle as usize + p.component as usize;
+            if c.gauge.iter().any(|&(g, _)| g == d) {
+                return Err(RunError::Setup(format!(
+                    "solver.control: the gauge's particle {} (at {:?}) has its {} displacement prescribed by a group; the gauge must measure free displacements: choose its groups (solver.control.plus, solver.control.minus) away from the supports and the loaded rows",
+                    p.particle,
+                    sim.x0[p.particle as usize].as_slice(),
+                    ["x", "y", "z"][p.component as usize]
+                )));
+            }
+        }
+    }
+    Ok(settings)
 }
 
 fn run_prepared<const K: usize, const D: usize>(
@@ -170,49 +240,7 @@ fn run_prepared<const K: usize, const D: usize>(
         SolverMethod::Relaxation | SolverMethod::QuasiStatic => {
             let s = &p.model.scene.solver;
             let quasi_static = method == SolverMethod::QuasiStatic;
-            let settings = relaxation::Settings {
-                increments: s.increments,
-                tolerance: s.tolerance,
-                max_iterations: s.max_iterations(),
-                ramp: p.model.scene.loading.ramp,
-                stop_after_peak: p.model.scene.loading.stop_after_peak,
-                stop_unconverged: quasi_static.then(|| s.max_residual.unwrap_or(s.tolerance)),
-                control: s.control.as_ref().map(|c| {
-                    let mut gauge = Vec::new();
-                    for (name, sign) in [(&c.plus, 1.0), (&c.minus, -1.0)] {
-                        let members = &p
-                            .model
-                            .groups
-                            .iter()
-                            .find(|g| &g.name == name)
-                            .expect("solver.control names a group (validated)")
-                            .members;
-                        let w = sign / members.len() as f64;
-                        gauge.extend(
-                            members
-                                .iter()
-                                .map(|&i| (D * i as usize + c.component.index(), w)),
-                        );
-                    }
-                    relaxation::Control {
-                        gauge,
-                        opening: c.opening,
-                    }
-                }),
-            };
-            if let Some(c) = &settings.control {
-                for p in &sim.prescribed {
-                    let d = D * p.particle as usize + p.component as usize;
-                    if c.gauge.iter().any(|&(g, _)| g == d) {
-                        return Err(RunError::Setup(format!(
-                            "solver.control: the gauge's particle {} (at {:?}) has its {} displacement prescribed by a group; the gauge must measure free displacements: choose its groups (solver.control.plus, solver.control.minus) away from the supports and the loaded rows",
-                            p.particle,
-                            sim.x0[p.particle as usize].as_slice(),
-                            ["x", "y", "z"][p.component as usize]
-                        )));
-                    }
-                }
-            }
+            let settings = incremental_settings(&p, &sim)?;
             // scenes with damage: the implicit secant solver; elastic scenes have no state
             // to hold, and relax (docs/quasi_static.md)
             let implicit = quasi_static && sim.inelastic.is_some();

@@ -22,7 +22,7 @@ pub mod summary;
 
 pub use crate::limits::available_memory;
 pub use dispatch::{dispatch, estimated_memory, TypedRun};
-pub use execute::{build_simulation, particle_stress, run};
+pub use execute::{build_simulation, damage_kernel, particle_stress, run};
 pub use generate::{Fcc, Generator, Hexagonal, RandomPlane, RandomSolid};
 pub use model::{estimated_particles, Model, SurfaceCorrection};
 pub use prepare::{prepare, prepare_model, prepare_model_with, prepare_with, Prepared};

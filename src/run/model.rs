@@ -93,7 +93,7 @@ pub fn estimated_particles(scene: &Scene) -> f64 {
 pub fn memory_in_slots(scene: &Scene, slots: usize) -> f64 {
     let dim = scene.dim();
     let damage = if scene.concrete.is_some() {
-        crate::solver::concrete::bytes_per_particle(dim, slots)
+        crate::solver::inelastic::bytes_per_particle(dim, slots)
     } else {
         0
     };

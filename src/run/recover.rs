@@ -5,7 +5,7 @@ use super::prepare::Prepared;
 use super::stress_recovery;
 use super::summary::voigt6;
 use crate::model::dimension::Dim;
-use crate::solver::concrete::ParticleDamage;
+use crate::solver::inelastic::ParticleDamage;
 use crate::solver::Simulation;
 
 /// What a run shows of each particle at its end: the stress (6 Voigt components) and, with

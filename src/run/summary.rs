@@ -6,7 +6,7 @@ use super::prepare::Prepared;
 use crate::discretise::groups;
 use crate::material::properties::{FieldReport, SampledField};
 use crate::scene::{Scene, SolverMethod};
-use crate::solver::concrete::ParticleDamage;
+use crate::solver::inelastic::ParticleDamage;
 use crate::solver::Record;
 use serde::Serialize;
 
@@ -220,24 +220,11 @@ pub(super) struct Finished<'a> {
     pub failure: Option<String>,
 }
 
-pub(super) fn summarise<const K: usize, const D: usize>(
-    p: &Prepared<K, D>,
-    run: &Finished,
-    damage: Option<&[ParticleDamage]>,
-) -> Summary {
-    let Finished {
-        kernel,
-        method,
-        report,
-        records,
-        wall_s,
-        wall,
-        threads,
-        ..
-    } = *run;
-    let s = &p.model.scene.solver;
+/// Why an incremental run's forces are not the quasi-static answer, if they are not: an
+/// increment that stopped the run unconverged, or increments left above the accepted residual.
+fn unconverged_message(s: &crate::scene::SolverSpec, report: &SolverReport) -> Option<String> {
     let accepted = s.max_residual.unwrap_or(s.tolerance);
-    let unconverged = match (report.unconverged_increments, report.max_final_residual) {
+    match (report.unconverged_increments, report.max_final_residual) {
         _ if report.stopped_unconverged.is_some() => report.stopped_unconverged.map(|inc| format!(
             "load increment {} of {} (load factor {:.4}) did not converge: after solver.max_iterations = {} iterations and {} state commits its out-of-balance force is {:.3e} × the reactions, above {} = {accepted:e}; the run stopped there, and its curve ends at the last converged increment. Raise solver.max_iterations (a crack that runs at a held displacement needs more iterations), or solver.increments, or accept the residual with solver.max_residual ≥ {:.2e}",
             inc.increment,
@@ -256,7 +243,26 @@ pub(super) fn summarise<const K: usize, const D: usize>(
             if s.max_residual.is_some() { "solver.max_residual" } else { "solver.tolerance" },
         )),
         _ => None,
-    };
+    }
+}
+
+pub(super) fn summarise<const K: usize, const D: usize>(
+    p: &Prepared<K, D>,
+    run: &Finished,
+    damage: Option<&[ParticleDamage]>,
+) -> Summary {
+    let Finished {
+        kernel,
+        method,
+        report,
+        records,
+        wall_s,
+        wall,
+        threads,
+        ..
+    } = *run;
+    let s = &p.model.scene.solver;
+    let unconverged = unconverged_message(s, &report);
     let failure = run.failure.clone();
     let status = if failure.is_some() {
         "unstable"

@@ -1,8 +1,7 @@
 //! Time integration of a discretised specimen: the step kernel, displacement loading,
 //! probes (reaction force, energies) and the stability guard (docs/architecture.md, "Solver").
 
-pub mod concrete;
-pub mod csr_kernel;
+pub mod inelastic;
 pub mod kernel;
 pub mod lanczos;
 pub mod linear;
@@ -267,7 +266,7 @@ pub struct Simulation<const D: usize, const K: usize> {
     /// Whether the kernel with bond dampers runs (decided once, before the loop).
     bond_dampers: bool,
     /// Damage and plasticity; `None` runs the elastic kernel.
-    pub inelastic: Option<Box<dyn concrete::Inelastic<D, K>>>,
+    pub inelastic: Option<Box<dyn inelastic::Inelastic<D, K>>>,
     /// Load factor held instead of the time ramp (dynamic relaxation), see [`Self::hold_load`].
     held: Option<HeldLoad>,
 }

@@ -3,9 +3,9 @@
 //! solved as a sequence of held-state equilibria.
 //!
 //! Within an increment the state (damage, plastic stretch, each bond's branch) is held
-//! (`Concrete::frozen`), so the internal force is that of an elastic body. Its equilibrium
+//! (`DamageKernel::frozen`), so the internal force is that of an elastic body. Its equilibrium
 //! with the prescribed displacements is found by Newton iterations on the secant stiffness
-//! (`concrete::secant_stiffness`, factorised by a sparse Cholesky of `faer`), each residual
+//! (`inelastic::secant_stiffness`, factorised by a sparse Cholesky of `faer`), each residual
 //! being the kernel's own force; the stiffness leaves out only the geometric term, so a few
 //! iterations reach the tolerance. At that equilibrium the state computed there is
 //! committed; the increment has converged when a commit moves no particle's damage by more
@@ -61,7 +61,7 @@ const MAX_STEP: f64 = 0.05;
 const STALLED: usize = 12;
 
 /// Adaptive increments: an increment in which some particle's damage grew by more than
-/// GROWTH_REFINE (from the increment's start to its converged state, `Concrete::growth`)
+/// GROWTH_REFINE (from the increment's start to its converged state, `DamageKernel::growth`)
 /// halves the next increment (down to MIN_REFINE of the scene's 1/`increments` of the
 /// ramp), one in which none grew by GROWTH_COARSEN doubles it (up to the scene's).
 ///
@@ -75,7 +75,7 @@ const GROWTH_COARSEN: f64 = 0.01;
 const MIN_REFINE: f64 = 1.0 / 64.0;
 
 /// Cut-back: an increment in which some particle's damage grew by more than this is undone
-/// (`Concrete::undo_increment`) and taken again in half the step, down to MIN_REFINE.
+/// (`DamageKernel::undo_increment`) and taken again in half the step, down to MIN_REFINE.
 ///
 /// **Decision (measured, 2026-12-03).** The load is held while the state settles, so the
 /// peak is recorded only at an increment, and where a crack opens in one increment the
@@ -141,7 +141,7 @@ impl Dofs {
 /// factorisation; measured: the allocating `faer::sparse::linalg::solvers::Llt`
 /// spent most of its time in the allocator and the kernel's page faults).
 struct Factor {
-    /// The (row, column) of each triplet of `concrete::secant_stiffness` when the pattern
+    /// The (row, column) of each triplet of `inelastic::secant_stiffness` when the pattern
     /// was built: a list of another length or order rebuilds it.
     entries: Vec<(usize, usize)>,
     /// Where each triplet goes in `values` (`usize::MAX`: a prescribed component).
@@ -356,6 +356,281 @@ fn gauge_opening<const D: usize>(
         .sum()
 }
 
+/// The Newton iterations of a run: the free components, the stiffness's pattern, symbolic
+/// analysis and numeric factor, and the step's right-hand side, kept across increments.
+struct Newton<'a> {
+    dofs: Dofs,
+    control: Option<&'a super::relaxation::Control>,
+    tolerance: f64,
+    tol2: f64,
+    max_iterations: usize,
+    /// The largest displacement of one Newton step (MAX_STEP of the shortest bond).
+    max_step: f64,
+    factor: Option<Factor>,
+    rhs: faer::Mat<f64>,
+    factorisations: usize,
+}
+
+impl<'a> Newton<'a> {
+    fn new<const D: usize, const K: usize>(sim: &Simulation<D, K>, s: &'a Settings) -> Self {
+        let control = s.control.as_ref();
+        let dofs = if control.is_some() {
+            Dofs::new(sim).with_amplitudes(sim)
+        } else {
+            Dofs::new(sim)
+        };
+        let max_step = MAX_STEP
+            / sim
+                .mech
+                .inv_l0
+                .iter()
+                .flat_map(|r| r.iter())
+                .fold(0.0, |a: f64, &b| a.max(b));
+        let rhs = faer::Mat::<f64>::zeros(dofs.count, 1);
+        Newton {
+            dofs,
+            control,
+            tolerance: s.tolerance,
+            tol2: s.tolerance * s.tolerance,
+            max_iterations: s.max_iterations,
+            max_step,
+            factor: None,
+            rhs,
+            factorisations: 0,
+        }
+    }
+
+    /// Iterate one increment to equilibrium of the held state, committing it as it balances
+    /// (see the module doc): the forces at the end, converged or not (`report` says which),
+    /// or why the iterations broke down and its remedy. `r` is the load factor (solved for
+    /// with indirect control, `target` the opening held); `converged_reaction2` the largest
+    /// squared reaction of a converged state so far.
+    fn equilibrate<const D: usize, const K: usize>(
+        &mut self,
+        sim: &mut Simulation<D, K>,
+        report: &mut IncrementReport,
+        r: &mut f64,
+        target: Option<f64>,
+        converged_reaction2: &mut f64,
+    ) -> Result<Vec<SVector<f64, D>>, (String, &'static str)> {
+        // the numeric factor must be recomputed before the next solve
+        let mut refactor = true;
+        let mut since_factor = 0;
+        let mut since_commit = 0;
+        loop {
+            let f = sim
+                .inelastic
+                .as_mut()
+                .expect("a model with state")
+                .forces(&sim.mech, &sim.state.x);
+            report.iterations += 1;
+            let (free2, reaction2) = norms(&f, &self.dofs);
+            let scale = reaction2.max(*converged_reaction2);
+            report.residual = if !(free2 + reaction2).is_finite() {
+                // a non-finite force anywhere ends the increment unconverged
+                f64::NAN
+            } else if scale > 0.0 {
+                (free2 / scale).sqrt()
+            } else {
+                0.0
+            };
+            // with indirect control the gauge must hold its opening too (it does after every
+            // full Newton step: the constraint is linear)
+            let held = match (self.control, target) {
+                (Some(c), Some(t)) => {
+                    (gauge_opening(&c.gauge, &sim.state.x, &sim.x0) - t).abs() <= self.tolerance * t
+                }
+                _ => true,
+            };
+            let balanced = held && (free2 <= self.tol2 * scale || (scale == 0.0 && free2 == 0.0));
+            if !report.residual.is_finite() {
+                report.converged = false;
+                return Ok(f);
+            }
+            since_commit += 1;
+            if balanced || since_commit > STALLED {
+                // the forces just computed left the trial state at x: commit it (also where
+                // the held problem stalls: see STALLED)
+                since_commit = 0;
+                let (dw, flips) = sim
+                    .inelastic
+                    .as_mut()
+                    .expect("a model with state")
+                    .commit(&sim.mech, &sim.state.x);
+                report.commits += 1;
+                if balanced && dw <= STATE_TOLERANCE && flips == 0 {
+                    report.converged = true;
+                    *converged_reaction2 = converged_reaction2.max(reaction2);
+                    return Ok(f);
+                }
+                refactor = true;
+            }
+            if report.iterations >= self.max_iterations {
+                report.converged = false;
+                return Ok(f);
+            }
+            if refactor || since_factor >= NEWTON_PER_FACTOR {
+                match Factor::refactorise(&mut self.factor, sim, &self.dofs) {
+                    Ok(()) => {
+                        refactor = false;
+                        self.factorisations += 1;
+                    }
+                    Err(e) => return Err((e, super::STIFFNESS_REMEDY)),
+                }
+                since_factor = 0;
+            }
+            // Newton: K·Δx = F on the free components
+            for (i, fi) in f.iter().enumerate() {
+                for c in 0..D {
+                    let col = self.dofs.column[D * i + c];
+                    if col != usize::MAX {
+                        self.rhs[(col, 0)] = fi[c];
+                    }
+                }
+            }
+            let fa = self.factor.as_mut().expect("factorised");
+            fa.solve(&mut self.rhs);
+            // with indirect control, the load factor's change that makes the gauge hold
+            // its opening: Δx = K⁻¹F + Δλ·K⁻¹q with Σw·Δx = opening − c(x) (bordering)
+            let mut dr = 0.0;
+            if let (Some(c), Some(t)) = (self.control, target) {
+                let dot = |v: &faer::Mat<f64>| -> f64 {
+                    c.gauge
+                        .iter()
+                        .map(|&(d, w)| w * v[(self.dofs.column[d], 0)])
+                        .sum()
+                };
+                let (wa, wq) = (dot(&self.rhs), dot(&fa.load));
+                let miss = t - gauge_opening(&c.gauge, &sim.state.x, &sim.x0);
+                if wq == 0.0 || !wq.is_finite() {
+                    return Err((format!("the gauge of solver.control no longer responds to the load (d opening / d load factor = {wq:.3e} m): the body has separated, or crushed, between the load and the gauge"), GAUGE_REMEDY));
+                }
+                dr = (miss - wa) / wq;
+                for col in 0..self.dofs.count {
+                    self.rhs[(col, 0)] += dr * fa.load[(col, 0)];
+                }
+            }
+            let largest = (0..self.dofs.count)
+                .map(|c| self.rhs[(c, 0)].abs())
+                .fold(0.0, f64::max);
+            let scale = if largest > self.max_step {
+                self.max_step / largest
+            } else {
+                1.0
+            };
+            for i in 0..sim.x0.len() {
+                for c in 0..D {
+                    let col = self.dofs.column[D * i + c];
+                    if col != usize::MAX {
+                        sim.state.x[i][c] += scale * self.rhs[(col, 0)];
+                    }
+                }
+            }
+            if target.is_some() {
+                *r += scale * dr;
+                for p in &sim.prescribed {
+                    let (i, c) = (p.particle as usize, p.component as usize);
+                    sim.state.x[i][c] = sim.x0[i][c] + p.amplitude * *r;
+                }
+            }
+            since_factor += 1;
+        }
+    }
+}
+
+/// The converged increments behind the current one: the displacements and load factors of
+/// the last two (the predictor), the load path's value there (the load factor, or with
+/// indirect control the gauge opening held), and the work of the prescribed displacements.
+struct Past<const D: usize> {
+    u1: Vec<SVector<f64, D>>,
+    u2: Vec<SVector<f64, D>>,
+    r1: f64,
+    r2: f64,
+    p1: f64,
+    p2: f64,
+    work: f64,
+    reaction_prev: Vec<f64>,
+}
+
+impl<const D: usize> Past<D> {
+    fn new<const K: usize>(sim: &Simulation<D, K>) -> Self {
+        let u1 = vec![SVector::<f64, D>::zeros(); sim.x0.len()];
+        Past {
+            u2: u1.clone(),
+            u1,
+            r1: 0.0,
+            r2: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+            work: 0.0,
+            reaction_prev: vec![0.0; sim.prescribed.len()],
+        }
+    }
+
+    /// The predictor: the free components (and, with indirect control, the load factor)
+    /// extrapolated from the last two increments to the load path's value `path`; the
+    /// prescribed components at the load factor, which it returns.
+    fn predict<const K: usize>(
+        &self,
+        sim: &mut Simulation<D, K>,
+        dofs: &Dofs,
+        path: f64,
+        target: Option<f64>,
+    ) -> f64 {
+        let alpha = if self.p1 > self.p2 {
+            (path - self.p1) / (self.p1 - self.p2)
+        } else {
+            0.0
+        };
+        let r = match target {
+            None => path,
+            Some(_) => self.r1 + alpha * (self.r1 - self.r2),
+        };
+        for i in 0..sim.x0.len() {
+            for c in 0..D {
+                if dofs.column[D * i + c] != usize::MAX {
+                    let u = self.u1[i][c] + alpha * (self.u1[i][c] - self.u2[i][c]);
+                    sim.state.x[i][c] = sim.x0[i][c] + u;
+                }
+            }
+        }
+        for p in &sim.prescribed {
+            let (i, c) = (p.particle as usize, p.component as usize);
+            sim.state.x[i][c] = sim.x0[i][c] + p.amplitude * r;
+        }
+        r
+    }
+
+    /// Record a converged increment at load factor `r` and path value `path`: the work of
+    /// the prescribed displacements (trapezoid rule, converged reactions) and the history.
+    fn converged<const K: usize>(
+        &mut self,
+        sim: &Simulation<D, K>,
+        forces: &[SVector<f64, D>],
+        r: f64,
+        path: f64,
+    ) {
+        for (q, p) in sim.prescribed.iter().enumerate() {
+            let reaction = -forces[p.particle as usize][p.component as usize];
+            self.work += 0.5 * (reaction + self.reaction_prev[q]) * p.amplitude * (r - self.r1);
+            self.reaction_prev[q] = reaction;
+        }
+        std::mem::swap(&mut self.u1, &mut self.u2);
+        for ((u, x), x0) in self
+            .u1
+            .iter_mut()
+            .zip(sim.state.x.iter())
+            .zip(sim.x0.iter())
+        {
+            *u = x - x0;
+        }
+        self.r2 = self.r1;
+        self.r1 = r;
+        self.p2 = self.p1;
+        self.p1 = path;
+    }
+}
+
 /// Run the increments of a scene with damage (see the module doc). Returns what the
 /// relaxation returns, so the run, the summary and the outputs treat both alike.
 pub fn solve<const D: usize, const K: usize>(
@@ -365,11 +640,7 @@ pub fn solve<const D: usize, const K: usize>(
     start: Instant,
 ) -> Relaxed {
     let control = s.control.as_ref();
-    let dofs = if control.is_some() {
-        Dofs::new(sim).with_amplitudes(sim)
-    } else {
-        Dofs::new(sim)
-    };
+    let mut newton = Newton::new(sim, s);
     let mut stop = PeakStop::quasi_static(s.stop_after_peak, probe);
     let mut out = Relaxed {
         records: Vec::with_capacity(s.increments + 1),
@@ -381,30 +652,9 @@ pub fn solve<const D: usize, const K: usize>(
         let model = sim.inelastic.as_mut().expect("a model with state");
         model.set_frozen(true, &sim.mech, &sim.state.x);
     }
-    let n = sim.x0.len();
-    let tol2 = s.tolerance * s.tolerance;
-    let max_step = MAX_STEP
-        / sim
-            .mech
-            .inv_l0
-            .iter()
-            .flat_map(|r| r.iter())
-            .fold(0.0, |a: f64, &b| a.max(b));
-    // converged displacements of the last two increments (the predictor) and their loads
-    let mut u1 = vec![SVector::<f64, D>::zeros(); n];
-    let mut u2 = u1.clone();
-    let (mut r1, mut r2) = (0.0, 0.0);
-    // the load path's value at the last two increments: the load factor, or with indirect
-    // control the gauge opening held
-    let (mut p1, mut p2) = (0.0, 0.0);
-    let mut work = 0.0;
-    let mut reaction_prev = vec![0.0; sim.prescribed.len()];
+    let mut past = Past::new(sim);
     let mut converged_reaction2: f64 = 0.0;
     let mut iterations = 0usize;
-    // the stiffness's pattern, symbolic analysis and numeric factor, kept across increments
-    let mut factor: Option<Factor> = None;
-    // the Newton step's right-hand side and solution, reused
-    let mut rhs = faer::Mat::<f64>::zeros(dofs.count, 1);
     let record = |sim: &Simulation<D, K>,
                   f: &[SVector<f64, D>],
                   r: f64,
@@ -445,29 +695,7 @@ pub fn solve<const D: usize, const K: usize>(
         // with indirect control: the opening held; the load factor is then an unknown
         let target = control.map(|c| c.opening * path);
         let path = target.unwrap_or(path);
-        // predictor: the free components (and the load factor) extrapolated from the last
-        // two increments
-        let alpha = if p1 > p2 {
-            (path - p1) / (p1 - p2)
-        } else {
-            0.0
-        };
-        let mut r = match target {
-            None => path,
-            Some(_) => r1 + alpha * (r1 - r2),
-        };
-        for i in 0..n {
-            for c in 0..D {
-                if dofs.column[D * i + c] != usize::MAX {
-                    let u = u1[i][c] + alpha * (u1[i][c] - u2[i][c]);
-                    sim.state.x[i][c] = sim.x0[i][c] + u;
-                }
-            }
-        }
-        for p in &sim.prescribed {
-            let (i, c) = (p.particle as usize, p.component as usize);
-            sim.state.x[i][c] = sim.x0[i][c] + p.amplitude * r;
-        }
+        let mut r = past.predict(sim, &newton.dofs, path, target);
         if let Some(model) = sim.inelastic.as_mut() {
             model.begin_increment();
         }
@@ -477,150 +705,23 @@ pub fn solve<const D: usize, const K: usize>(
             opening_m: target,
             ..Default::default()
         };
-        // the numeric factor must be recomputed before the next solve
-        let mut refactor = true;
-        let mut since_factor = 0;
-        let mut since_commit = 0;
-        let forces = loop {
-            let f = sim
-                .inelastic
-                .as_mut()
-                .expect("a model with state")
-                .forces(&sim.mech, &sim.state.x);
-            report.iterations += 1;
-            let (free2, reaction2) = norms(&f, &dofs);
-            let scale = reaction2.max(converged_reaction2);
-            report.residual = if !(free2 + reaction2).is_finite() {
-                // a non-finite force anywhere ends the increment unconverged
-                f64::NAN
-            } else if scale > 0.0 {
-                (free2 / scale).sqrt()
-            } else {
-                0.0
-            };
-            // with indirect control the gauge must hold its opening too (it does after every
-            // full Newton step: the constraint is linear)
-            let held = match (control, target) {
-                (Some(c), Some(t)) => {
-                    (gauge_opening(&c.gauge, &sim.state.x, &sim.x0) - t).abs() <= s.tolerance * t
-                }
-                _ => true,
-            };
-            let balanced = held && (free2 <= tol2 * scale || (scale == 0.0 && free2 == 0.0));
-            if !report.residual.is_finite() {
-                report.converged = false;
-                break f;
-            }
-            since_commit += 1;
-            if balanced || since_commit > STALLED {
-                // the forces just computed left the trial state at x: commit it (also where
-                // the held problem stalls: see STALLED)
-                since_commit = 0;
-                let (dw, flips) = sim
-                    .inelastic
-                    .as_mut()
-                    .expect("a model with state")
-                    .commit(&sim.mech, &sim.state.x);
-                report.commits += 1;
-                if balanced && dw <= STATE_TOLERANCE && flips == 0 {
-                    report.converged = true;
-                    converged_reaction2 = converged_reaction2.max(reaction2);
-                    break f;
-                }
-                refactor = true;
-            }
-            if report.iterations >= s.max_iterations {
-                report.converged = false;
-                break f;
-            }
-            if refactor || since_factor >= NEWTON_PER_FACTOR {
-                match Factor::refactorise(&mut factor, sim, &dofs) {
-                    Ok(()) => {
-                        refactor = false;
-                        out.factorisations += 1;
-                    }
-                    Err(e) => {
-                        out.failure = Some(super::Unstable {
-                            at: Location::Increment {
-                                increment: out.increments.len() + 1,
-                                load_factor: r,
-                                iteration: iterations + report.iterations,
-                                remedy: super::STIFFNESS_REMEDY,
-                            },
-                            what: e,
-                        });
-                        out.increments.push(report);
-                        break 'increments;
-                    }
-                }
-                since_factor = 0;
-            }
-            // Newton: K·Δx = F on the free components
-            for (i, fi) in f.iter().enumerate() {
-                for c in 0..D {
-                    let col = dofs.column[D * i + c];
-                    if col != usize::MAX {
-                        rhs[(col, 0)] = fi[c];
-                    }
-                }
-            }
-            let fa = factor.as_mut().expect("factorised");
-            fa.solve(&mut rhs);
-            // with indirect control, the load factor's change that makes the gauge hold
-            // its opening: Δx = K⁻¹F + Δλ·K⁻¹q with Σw·Δx = opening − c(x) (bordering)
-            let mut dr = 0.0;
-            if let (Some(c), Some(t)) = (control, target) {
-                let dot = |v: &faer::Mat<f64>| -> f64 {
-                    c.gauge
-                        .iter()
-                        .map(|&(d, w)| w * v[(dofs.column[d], 0)])
-                        .sum()
-                };
-                let (wa, wq) = (dot(&rhs), dot(&fa.load));
-                let miss = t - gauge_opening(&c.gauge, &sim.state.x, &sim.x0);
-                if wq == 0.0 || !wq.is_finite() {
+        let forces =
+            match newton.equilibrate(sim, &mut report, &mut r, target, &mut converged_reaction2) {
+                Ok(f) => f,
+                Err((what, remedy)) => {
                     out.failure = Some(super::Unstable {
                         at: Location::Increment {
                             increment: out.increments.len() + 1,
                             load_factor: r,
                             iteration: iterations + report.iterations,
-                            remedy: GAUGE_REMEDY,
+                            remedy,
                         },
-                        what: format!("the gauge of solver.control no longer responds to the load (d opening / d load factor = {wq:.3e} m): the body has separated, or crushed, between the load and the gauge"),
+                        what,
                     });
                     out.increments.push(report);
                     break 'increments;
                 }
-                dr = (miss - wa) / wq;
-                for col in 0..dofs.count {
-                    rhs[(col, 0)] += dr * fa.load[(col, 0)];
-                }
-            }
-            let largest = (0..dofs.count)
-                .map(|c| rhs[(c, 0)].abs())
-                .fold(0.0, f64::max);
-            let scale = if largest > max_step {
-                max_step / largest
-            } else {
-                1.0
             };
-            for i in 0..n {
-                for c in 0..D {
-                    let col = dofs.column[D * i + c];
-                    if col != usize::MAX {
-                        sim.state.x[i][c] += scale * rhs[(col, 0)];
-                    }
-                }
-            }
-            if target.is_some() {
-                r += scale * dr;
-                for p in &sim.prescribed {
-                    let (i, c) = (p.particle as usize, p.component as usize);
-                    sim.state.x[i][c] = sim.x0[i][c] + p.amplitude * r;
-                }
-            }
-            since_factor += 1;
-        };
         report.load_factor = r;
         let growth = sim.inelastic.as_ref().expect("a model with state").growth();
         iterations += report.iterations;
@@ -653,27 +754,14 @@ pub fn solve<const D: usize, const K: usize>(
             out.stopped_unconverged = Some(report);
             break;
         }
-        // work of the prescribed displacements (trapezoid rule, converged reactions)
-        for (q, p) in sim.prescribed.iter().enumerate() {
-            let reaction = -forces[p.particle as usize][p.component as usize];
-            work += 0.5 * (reaction + reaction_prev[q]) * p.amplitude * (r - r1);
-            reaction_prev[q] = reaction;
-        }
-        std::mem::swap(&mut u1, &mut u2);
-        for ((u, x), x0) in u1.iter_mut().zip(sim.state.x.iter()).zip(sim.x0.iter()) {
-            *u = x - x0;
-        }
-        r2 = r1;
-        r1 = r;
-        p2 = p1;
-        p1 = path;
+        past.converged(sim, &forces, r, path);
         // smaller steps while damage grows, back to the scene's once it stops
         if growth > GROWTH_REFINE {
             refine = (refine * 0.5).max(MIN_REFINE);
         } else if growth < GROWTH_COARSEN {
             refine = (refine * 2.0).min(1.0);
         }
-        let rec = record(sim, &forces, r, work, iterations);
+        let rec = record(sim, &forces, r, past.work, iterations);
         out.records.push(rec);
         out.wall_s.push(start.elapsed().as_secs_f64());
         if stop.reached(&rec, sim) {
@@ -681,6 +769,7 @@ pub fn solve<const D: usize, const K: usize>(
             break;
         }
     }
+    out.factorisations = newton.factorisations;
     sim.state.v.iter_mut().for_each(|v| *v = SVector::zeros());
     if let Some(model) = sim.inelastic.as_mut() {
         model.set_frozen(false, &sim.mech, &sim.state.x);

@@ -202,7 +202,7 @@ fn bench_dim_3_runs_the_fcc_kernels() {
             v["bytes_per_particle"].as_u64(),
             Some(
                 (sppm::discretise::bytes_per_particle(3, 18)
-                    + sppm::solver::concrete::bytes_per_particle(3, 18)) as u64
+                    + sppm::solver::inelastic::bytes_per_particle(3, 18)) as u64
             )
         );
     }

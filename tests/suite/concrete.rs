@@ -7,8 +7,8 @@ use crate::common;
 use common::tension_block;
 
 use nalgebra::Vector2;
-use sppm::run::{build_simulation, prepare, run, RunOptions};
-use sppm::solver::concrete;
+use sppm::run::{build_simulation, damage_kernel, prepare, run, RunOptions};
+use sppm::solver::inelastic;
 use sppm::Scene;
 
 /// With strengths no load reaches, the concrete kernel follows the elastic one: the same
@@ -59,7 +59,7 @@ fn undamaged_concrete_kernel_is_the_elastic_kernel() {
 fn fully_damaged_particle_transmits_no_force() {
     let scene = tension_block(0.1, 0.01, &[]);
     let mut p = prepare(&scene, sppm::run::Hexagonal).unwrap();
-    let mut sim = build_simulation(&mut p);
+    let sim = build_simulation(&mut p);
     let n = sim.x0.len();
     // a strained, partly damaged state
     let x: Vec<Vector2<f64>> = sim
@@ -67,7 +67,7 @@ fn fully_damaged_particle_transmits_no_force() {
         .iter()
         .map(|x| x + Vector2::new(-2e-5 * x.x + 1e-6 * (37.0 * x.y).sin(), 1e-4 * x.y))
         .collect();
-    let model = sim.inelastic.as_mut().unwrap().concrete_mut().unwrap();
+    let model = &mut damage_kernel(&p.model).unwrap();
     for (i, d) in model.committed.iter_mut().enumerate() {
         d.wt = (i % 7) as f64 / 9.0;
         d.wc = (i % 5) as f64 / 11.0;
@@ -75,10 +75,10 @@ fn fully_damaged_particle_transmits_no_force() {
     let broken = n / 2;
     model.committed[broken].wt = 1.0;
     model.committed[broken].wc = 1.0;
-    let f0 = concrete::internal_forces(&sim.mech, model, &x);
+    let f0 = inelastic::internal_forces(&sim.mech, model, &x);
     let mut moved = x.clone();
     moved[broken] += Vector2::new(3e-4, -2e-4);
-    let f1 = concrete::internal_forces(&sim.mech, model, &moved);
+    let f1 = inelastic::internal_forces(&sim.mech, model, &moved);
     assert_eq!(f0[broken], Vector2::zeros());
     assert_eq!(f1[broken], Vector2::zeros());
     for i in 0..n {
@@ -120,8 +120,8 @@ fn uniaxial_tension_reaches_ft_and_dissipates_gf() {
                 );
                 dissipated_max = dissipated_max.max(d);
                 records.push(r);
-                let c = sim.inelastic.as_ref().unwrap().concrete().unwrap();
-                for (i, s) in c.committed.iter().enumerate() {
+                let damage = sim.inelastic.as_ref().unwrap().damage();
+                for (i, s) in damage.iter().enumerate() {
                     assert!(s.wt >= last[i].0 && s.wc >= last[i].1, "damage decreased");
                     assert!((0.0..=1.0).contains(&s.wt) && (0.0..=1.0).contains(&s.wc));
                     last[i] = (s.wt, s.wc);
@@ -251,23 +251,19 @@ fn tension_kernel_matches_the_full_kernel_bit_for_bit() {
     let mut runs = Vec::new();
     for force_full in [false, true] {
         let mut p = prepare(&scene, sppm::run::Hexagonal).unwrap();
+        let mut kernel = damage_kernel(&p.model).unwrap();
+        kernel.force_full = force_full;
         let mut sim = build_simulation(&mut p);
-        sim.inelastic
-            .as_mut()
-            .unwrap()
-            .concrete_mut()
-            .unwrap()
-            .force_full = force_full;
+        sim.inelastic = Some(Box::new(kernel));
         let probe = &p.probe.as_ref().unwrap().1;
         let forces: Vec<f64> = (0..p.steps)
             .filter_map(|_| sim.advance(Some(probe)).map(|r| r.force_n))
             .collect();
-        let c = sim.inelastic.as_ref().unwrap().concrete().unwrap();
         runs.push((
             sim.kernel(),
             forces,
             sim.state.x.clone(),
-            c.committed.clone(),
+            sim.inelastic.as_ref().unwrap().damage(),
         ));
     }
     let (tension, full) = (&runs[0], &runs[1]);

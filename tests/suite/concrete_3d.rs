@@ -15,7 +15,7 @@ use sppm::discretise::{Particles, NONE};
 use sppm::model::damage::ConcreteLaw;
 use sppm::model::two_spring::TwoSpring;
 use sppm::scene::{CrackOpening, Initiation, Plane};
-use sppm::solver::concrete::{self, Concrete};
+use sppm::solver::inelastic::{self, DamageKernel};
 use sppm::solver::mechanics::Mechanics;
 
 const N: i64 = 4;
@@ -109,8 +109,8 @@ fn rankine_initiation_in_3d_at_the_isotropic_stress() {
             p.x0.iter()
                 .map(|x| Vector3::new(x.x * (1.0 + eps), x.y, x.z))
                 .collect();
-        let mut c: Concrete<3, 18> = Concrete::new(TwoSpring::new(l, None), &p);
-        concrete::internal_forces(&m, &mut c, &x);
+        let mut c: DamageKernel<3, 18> = DamageKernel::new(TwoSpring::new(l, None), &p);
+        inelastic::internal_forces(&m, &mut c, &x);
         c.commit();
         for (i, d) in c.damage().iter().enumerate() {
             assert_eq!(d.initiated, expect, "particle {i} at ε = {factor}·f't/D11");
@@ -191,8 +191,8 @@ fn fcc_damage_kernel_carries_the_second_neighbour_modulus() {
     let x = strained(&p);
     let mut strong = law();
     (strong.ft, strong.fc) = (1e12, 1e13);
-    let mut c: Concrete<3, 18> = Concrete::new(TwoSpring::new(strong, None), &p);
-    let f = concrete::internal_forces(&m, &mut c, &x);
+    let mut c: DamageKernel<3, 18> = DamageKernel::new(TwoSpring::new(strong, None), &p);
+    let f = inelastic::internal_forces(&m, &mut c, &x);
     let mut bt = vec![0.0; n];
     pass_dilatation(&m, &x, &mut bt);
     let v = vec![Vector3::zeros(); n];
@@ -208,8 +208,8 @@ fn fcc_damage_kernel_carries_the_second_neighbour_modulus() {
     // with c left out the forces differ: the test sees the modulus
     let mut without = m.clone();
     without.second = None;
-    let mut c0: Concrete<3, 18> = Concrete::new(TwoSpring::new(strong, None), &p);
-    let f0 = concrete::internal_forces(&without, &mut c0, &x);
+    let mut c0: DamageKernel<3, 18> = DamageKernel::new(TwoSpring::new(strong, None), &p);
+    let f0 = inelastic::internal_forces(&without, &mut c0, &x);
     let diff = f
         .iter()
         .zip(&f0)
@@ -218,7 +218,7 @@ fn fcc_damage_kernel_carries_the_second_neighbour_modulus() {
     assert!(diff > 0.1 * scale, "{diff} against {scale}");
 
     // damage of every kind, fixed: the energy is the potential of the force
-    let mut c: Concrete<3, 18> = Concrete::new(TwoSpring::new(law(), None), &p);
+    let mut c: DamageKernel<3, 18> = DamageKernel::new(TwoSpring::new(law(), None), &p);
     for (i, s) in c.committed.iter_mut().enumerate() {
         s.wt = match i % 5 {
             0 | 1 => 0.0,
@@ -229,8 +229,8 @@ fn fcc_damage_kernel_carries_the_second_neighbour_modulus() {
         s.eps_init = 1e-4;
     }
     assert!(c.committed.iter().any(|s| s.wt > 0.0 && s.wt < 1.0));
-    let f = concrete::internal_forces(&m, &mut c, &x);
-    let energy = |xs: &[Vector3<f64>]| concrete::internal_energy(&m, &c, xs);
+    let f = inelastic::internal_forces(&m, &mut c, &x);
+    let energy = |xs: &[Vector3<f64>]| inelastic::internal_energy(&m, &c, xs);
     // A bond's factor switches where its stretch changes sign (w_t acts only in tension), and
     // there a broken bond's force jumps: leave out particles with a bond within 100·h/L0 of
     // zero stretch.
@@ -341,8 +341,8 @@ fn interaction_initiation_on_the_fcc_lattice() {
             p.x0.iter()
                 .map(|x| Vector3::new(x.x * (1.0 + e1), x.y * (1.0 + e2), x.z * (1.0 + e3)))
                 .collect();
-        let mut c: Concrete<3, 18> = Concrete::new(TwoSpring::new(l, None), &p);
-        concrete::internal_forces(&m, &mut c, &x);
+        let mut c: DamageKernel<3, 18> = DamageKernel::new(TwoSpring::new(l, None), &p);
+        inelastic::internal_forces(&m, &mut c, &x);
         c.commit();
         for (i, d) in c.damage().iter().enumerate() {
             assert_eq!(d.initiated, expect, "particle {i} at s = {s}");

@@ -11,7 +11,7 @@ use crate::common;
 
 use sppm::model::damage_law::{DamageLaw, Kernel, ParticleBonds, ParticleDamage};
 use sppm::run::{build_simulation, prepare};
-use sppm::solver::concrete::Concrete;
+use sppm::solver::inelastic::DamageKernel;
 
 /// Brittle failure of a particle once any of its bonds stretches beyond `critical`.
 struct Brittle {
@@ -61,7 +61,8 @@ fn a_brittle_bond_law_runs_through_the_concrete_kernel() {
     assert!(sim.inelastic.is_none());
     // the plate is pulled to a strain of 1e-4: fail bonds at 0.5e-4
     let critical = 0.5e-4;
-    let law: Concrete<2, 6, Brittle> = Concrete::new(Brittle { critical }, &p.model.particles);
+    let law: DamageKernel<2, 6, Brittle> =
+        DamageKernel::new(Brittle { critical }, &p.model.particles);
     sim.inelastic = Some(Box::new(law));
     let probe = p.probe.as_ref().unwrap().1.clone();
     let mut peak: f64 = 0.0;

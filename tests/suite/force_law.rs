@@ -2,10 +2,10 @@
 //! computed through every caller's path, agree.
 //!
 //! Paths: the elastic step kernel (`kernel::particle_force` after `pass_dilatation`), the
-//! concrete kernel with no damage (`concrete::internal_forces`), the linearised operator
+//! concrete kernel with no damage (`inelastic::internal_forces`), the linearised operator
 //! (`LinearOperator::internal_forces`), the energies (`Simulation::internal_energy_now`,
-//! `concrete::internal_energy`) and the stress recovery (`run::particle_stress`,
-//! `concrete::particle_stress`).
+//! `inelastic::internal_energy`) and the stress recovery (`run::particle_stress`,
+//! `inelastic::particle_stress`).
 //!
 //! Expected agreement: the elastic and the undamaged concrete kernel evaluate the same force
 //! state with the additions grouped differently (½((a_i+a_j)S + bθ_i + bθ_j) against
@@ -22,7 +22,7 @@ use rand::{Rng, SeedableRng};
 use sppm::model::damage::ConcreteLaw;
 use sppm::model::two_spring::TwoSpring;
 use sppm::run::{build_simulation, particle_stress, prepare};
-use sppm::solver::concrete::{self, Concrete};
+use sppm::solver::inelastic::{self, DamageKernel};
 use sppm::solver::kernel::{particle_force, pass_dilatation};
 use sppm::solver::linear::LinearOperator;
 
@@ -62,8 +62,9 @@ fn kernel_concrete_kernel_and_linear_operator_give_the_same_forces() {
             .collect();
         // the concrete kernel, undamaged
         let law = ConcreteLaw::from_scene(&p.model.scene).unwrap();
-        let mut c: Concrete<2, 6> = Concrete::new(TwoSpring::new(law, None), &p.model.particles);
-        let f_concrete = concrete::internal_forces(m, &mut c, &x);
+        let mut c: DamageKernel<2, 6> =
+            DamageKernel::new(TwoSpring::new(law, None), &p.model.particles);
+        let f_concrete = inelastic::internal_forces(m, &mut c, &x);
         let scale = f_kernel.iter().map(|f| f.norm()).fold(0.0, f64::max);
         for i in 0..n {
             for k in 0..2 {
@@ -163,8 +164,8 @@ fn stress_recovery_is_the_same_through_both_paths() {
     let x: Vec<_> = x0.iter().zip(&u).map(|(a, b)| a + b).collect();
     let elastic = particle_stress(m, vol, &x);
     let law = ConcreteLaw::from_scene(&p.model.scene).unwrap();
-    let c: Concrete<2, 6> = Concrete::new(TwoSpring::new(law, None), &p.model.particles);
-    let damaged = concrete::particle_stress(m, &c, &x, vol);
+    let c: DamageKernel<2, 6> = DamageKernel::new(TwoSpring::new(law, None), &p.model.particles);
+    let damaged = inelastic::particle_stress(m, &c, &x, vol);
     let scale = elastic.iter().map(|s| s.norm()).fold(0.0, f64::max);
     assert!(scale > 0.0);
     for i in 0..x.len() {

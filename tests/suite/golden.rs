@@ -113,7 +113,7 @@ const GOLDEN: &[Golden] = &[
     // Random particles, the same numbers on 1 and 2 threads. Re-recorded when the
     // Voronoi cells were cut about their particle in one frame (the volumes moved in their
     // last bits; peak −6e-11 relative, energy +4e-13), when damaged neighbours left the
-    // criteria's neighbourhood mean (solver::concrete::Neighbourhood: peak 58.51 → 56.53 kN,
+    // criteria's neighbourhood mean (solver::inelastic::Neighbourhood: peak 58.51 → 56.53 kN,
     // energy 1.771 → 1.911 J for this set; over 10 sets the energy fell), and when the scene
     // moved to L0 = 7 mm with the random particles' crack band 3.2 (was 10 mm and 2.8: over
     // 200 runs the energy is 1.017 × G_f·A; docs/sppm.md, "Crack band").

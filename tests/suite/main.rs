@@ -7,7 +7,6 @@ mod common;
 mod concrete;
 mod concrete_3d;
 mod concrete_input;
-mod csr_layout;
 mod cutouts;
 mod damage_law;
 mod elastic_plate;

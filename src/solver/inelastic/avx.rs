@@ -6,7 +6,8 @@
 //! damaged axial term and the dilatation sums (§6). The law update of each particle stays
 //! scalar (`law_pass`).
 
-use super::{slot_cache_at, Concrete, Stretches, FIELDS};
+use super::passes::{slot_cache_at, Stretches, FIELDS};
+use super::DamageKernel;
 use crate::discretise::NONE;
 use crate::model::damage_law::DamageLaw;
 use crate::model::dimension::{Dim, Dimension};
@@ -35,7 +36,7 @@ unsafe fn lanes(v: __m256d) -> [f64; 4] {
 #[target_feature(enable = "avx")]
 #[inline]
 unsafe fn series_damage<const D: usize, const K: usize, L: DamageLaw<D, K>>(
-    c: &Concrete<D, K, L>,
+    c: &DamageKernel<D, K, L>,
     p: [usize; LANES],
 ) -> (__m256d, __m256d)
 where
@@ -107,7 +108,7 @@ pub(super) unsafe fn slot_block<
     const WEIGHTED: bool,
 >(
     m: &Mechanics<D, K>,
-    c: &Concrete<D, K, L>,
+    c: &DamageKernel<D, K, L>,
     x: &[SVector<f64, D>],
     i0: usize,
     cache: &mut [f64],
@@ -259,7 +260,7 @@ pub(super) unsafe fn slot_block<
 #[inline]
 unsafe fn force_block<const D: usize, const K: usize, L: DamageLaw<D, K>, const DAMP: bool>(
     m: &Mechanics<D, K>,
-    c: &Concrete<D, K, L>,
+    c: &DamageKernel<D, K, L>,
     r: &StateReads<'_, D>,
     i0: usize,
 ) -> ([__m256d; D], __m256d)
@@ -349,7 +350,7 @@ pub(super) unsafe fn update_chunk<
     const DAMP: bool,
 >(
     m: &Mechanics<D, K>,
-    c: &Concrete<D, K, L>,
+    c: &DamageKernel<D, K, L>,
     r: &StateReads<'_, D>,
     dt: f64,
     base: usize,
