@@ -7,7 +7,7 @@
 //! # Layers
 //!
 //! One pipeline serves every discretisation and dimension, in layers that import only from
-//! below (checked by `tests/layering.rs`, which also finds no import circle between the
+//! below (checked by `tests/suite/layering.rs`, which also finds no import circle between the
 //! files of a module):
 //!
 //! 0. tools: [`aligned`], [`console`], [`fsio`], [`limits`], [`geometry`], [`random_field`];

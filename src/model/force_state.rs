@@ -6,7 +6,7 @@
 //! eigenvalue bound (`solver::mechanics`), the energy (`solver::Simulation`) and the stress
 //! recovery (`run::particle_stress`, `solver::inelastic::particle_stress`). The AVX path of the
 //! slot layout (`solver::kernel::avx`) performs the same IEEE operations lane by lane and is
-//! tested bit-identical to them; `tests/force_law.rs` evaluates random configurations
+//! tested bit-identical to them; `tests/suite/force_law.rs` evaluates random configurations
 //! through every caller and finds them equal.
 //!
 //! With micro-moduli a_i, b_i (and, for FCC second neighbours, a bond modulus a_i + c_i

@@ -14,7 +14,7 @@
 //! The table holds, per minimum distance and fitted in-plane ν*, the mean (ν*, E/E*, ν) of a
 //! 100 × 200 mm plate: for the default 0.7 over 10 particle sets at L0 = 1 mm (W/L0 = 100),
 //! for 0.5, 0.6 and 0.75 over 8 sets at L0 = 2 mm. Regenerate it with
-//! `cargo test --release --test sppm_elastic -- --ignored --nocapture calibration_table`.
+//! `cargo test --release --test suite -- --ignored --nocapture sppm_elastic::calibration_table`.
 //! Plane strain uses the same in-plane map (the 2D model sees only in-plane constants:
 //! E' = E/(1−ν²), ν' = ν/(1−ν)).
 //!
@@ -24,7 +24,7 @@
 //! W/L0 = 20; 0.851 at W/L0 = 16 against 0.854 at 24). [`fit_target_3d`] reads the 3D table:
 //! per minimum distance and fitted ν*, the mean (ν*, E/E*, ν) of a W × W × 2W block
 //! (W/L0 = 20) over 4 particle sets, pulled along its length with the sides free. Regenerate
-//! it with `cargo test --release --test sppm3d -- --ignored --nocapture calibration_table_3d`.
+//! it with `cargo test --release --test suite -- --ignored --nocapture sppm3d::calibration_table_3d`.
 
 use crate::scene::Plane;
 

@@ -113,7 +113,7 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
     let scene = &model.scene.clone();
     // A free particle with one bond has no stiffness across it: a zero-frequency mode that
     // Lanczos may or may not report (with clipped cells it found ω² ≈ 3e-5 rad²/s² and
-    // T1 = 1e3 s for the spike of tests/proptest_scenes.rs); refuse it before.
+    // T1 = 1e3 s for the spike of tests/suite/proptest_scenes.rs); refuse it before.
     let p = &model.particles;
     let swings = |i: usize| {
         if p.bond_count(i) != 1 {

@@ -847,7 +847,7 @@ impl Default for DampingSpec {
 }
 
 /// Which reading of the source's one-step force lag (docs/model.md §4). Default chosen by
-/// measurement (tests/vibration_and_stability.rs, tests/run_plate.rs):
+/// measurement (tests/suite/vibration_and_stability.rs, tests/suite/run_plate.rs):
 ///
 /// - undamped free vibration of a bar over 100 periods: (B) drifts by −6.6e-6 in energy
 ///   (largest excursion 1.2e-3); (A) blows up within 51 steps (energy ×3.8e25);

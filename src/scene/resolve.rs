@@ -170,7 +170,7 @@ impl Scene {
         // the shear stiffness E/(2(1+ν)) turns it into a stress change that overshoots the
         // yield surface more and more as ν → −1, and the run diverges: measured unstable at
         // ν = −0.9 (compression block, L0 = 20 mm) and −0.93, stable at −0.8 and −0.92
-        // (tests/proptest_scenes.rs, regression_auxetic_concrete_plasticity).
+        // (tests/suite/proptest_scenes.rs, regression_auxetic_concrete_plasticity).
         let nu = self.material.nu;
         if c.plasticity && nu < -0.8 {
             return Err(invalid(

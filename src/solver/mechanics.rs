@@ -140,7 +140,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
     /// Model of a body with its micro-moduli (`p.a`, `p.b`, `p.c`) and density; dampers off.
     ///
     /// [`Self::second`] is set when any c_i is non-zero (not merely because K = 18: a body
-    /// with 18 slots and no c, such as the simple-cubic block of `tests/concrete_3d.rs`, keeps
+    /// with 18 slots and no c, such as the simple-cubic block of `tests/suite/concrete_3d.rs`, keeps
     /// the kernels without c); the second-neighbour slots are then those of
     /// [`first_second_slot`], which must know K.
     pub fn new(p: &Particles<D, K>, rho: &[f64]) -> Self {

@@ -388,7 +388,7 @@ pub fn static_response<const D: usize, const K: usize>(
 /// Static linear-elastic response to applied forces (small strain): K·u = f on the free
 /// components, u = 0 on the constrained ones (rigid motions the constraints leave free are
 /// removed; the forces must not load them). Used to measure stiffnesses (the cantilever of
-/// `tests/surfaces.rs` and `benchmarks/surfaces.rs`).
+/// `tests/suite/surfaces.rs` and `benchmarks/surfaces.rs`).
 pub fn static_force_response<const D: usize, const K: usize>(
     mech: &Mechanics<D, K>,
     x0: &[SVector<f64, D>],

@@ -13,7 +13,7 @@
 //! 1.5× and the bond-damping rate by 2×, and with the source's ξ_in = 0.2 (ζ ≈ 1 at ω_max)
 //! it halved the time step. The Gershgorin value is still computed and reported
 //! ([`Mechanics::max_eigenvalue_bound`]): the Lanczos value must lie below it. The estimate
-//! is checked against the measured instability threshold in tests/stability.rs.
+//! is checked against the measured instability threshold in tests/suite/stability.rs.
 
 use super::lanczos::{Extreme, Lanczos};
 use super::linear::{apply_bond_dampers, LinearOperator};

@@ -1,7 +1,7 @@
 //! Elastic stiffness of simple members against theory, solved statically (small strain):
 //! a cantilever against Timoshenko's tip stiffness and a plate in uniaxial tension against E.
 //! They measure how a discretisation's boundary particles carry stiffness
-//! (`discretisation.surface`; tests/surfaces.rs, benchmarks/surfaces.rs).
+//! (`discretisation.surface`; tests/suite/surfaces.rs, benchmarks/surfaces.rs).
 
 use crate::run::{prepare_model, Hexagonal, Model, RunError};
 use crate::scene::Scene;

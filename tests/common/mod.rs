@@ -207,8 +207,8 @@ pub fn sppm(args: &[&str]) -> std::process::Output {
 }
 
 /// A coarse dog-bone for study tests (D0 = 0.1 m at L0 = 8 mm, 223 particles, an f't random
-/// field, relaxation to 80% after the peak): tests/montecarlo.rs and
-/// tests/reliability_studies.rs.
+/// field, relaxation to 80% after the peak): tests/suite/montecarlo.rs and
+/// tests/suite/reliability_studies.rs.
 pub const TINY_DOGBONE: &str = r#"
 name = "tiny_dogbone"
 [body]

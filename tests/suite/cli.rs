@@ -251,7 +251,7 @@ fn an_unstable_run_names_step_and_particle() {
 /// A concrete scene writes the crack map and particles.csv, and its summary lists the damage
 /// figures and the material values with their sources. The shipped tension block, coarsened
 /// to L0 = 25 mm and shortened: the crack map is checked for existence, not for physics
-/// (tests/concrete.rs does that).
+/// (tests/suite/concrete.rs does that).
 #[test]
 fn concrete_run_writes_crack_map_and_damage_summary() {
     let out = tmp("concrete");

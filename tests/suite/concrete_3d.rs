@@ -266,6 +266,10 @@ fn fcc_damage_kernel_carries_the_second_neighbour_modulus() {
 /// benchmarks/RESULTS.md "Concrete in 3D"), kinetic/internal energy ≤ 5% up to the peak, and
 /// one crack normal to the load across the whole section.
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn tension_prism_reaches_ft_dissipates_gf_and_cracks_across() {
     use sppm::run::{run, RunOptions};
     let scene = sppm::Scene::from_file(

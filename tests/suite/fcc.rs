@@ -237,6 +237,10 @@ fn cylinders_and_prisms_carry_their_volume_and_3d_concrete_prepares() {
 /// gives E and ν within 1% at 0° and two general rotations (W = 20·L0: the surface layer of
 /// clipped cells costs O(L0/W); measured 0.3–0.9%, benchmarks/RESULTS.md "FCC").
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn elastic_block_gives_e_and_nu_within_one_percent_at_three_orientations() {
     use nalgebra::Vector3;
     use sppm::discretise::fcc::FccLattice;
@@ -266,6 +270,10 @@ fn elastic_block_gives_e_and_nu_within_one_percent_at_three_orientations() {
 /// kinetic energy is 5e-4 of its internal energy), and both near the input (E, ν) as the
 /// static block of W = 10·L0 is (within 3%).
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn the_elastic_prism_runs_to_its_static_solution() {
     use nalgebra::Vector3;
     use sppm::study::elastic_checks::prism_moduli;

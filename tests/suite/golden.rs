@@ -223,7 +223,11 @@ const GOLDEN_SOURCE_SURFACE: &[Golden] = &[
 ];
 
 #[test]
-fn the_source_surface_reproduces_the_records_before_issue_14() {
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
+fn the_source_surface_reproduces_its_earlier_records() {
     for g in GOLDEN_SOURCE_SURFACE {
         check_in(
             GOLDEN_SOURCE_SURFACE,
@@ -254,7 +258,7 @@ fn every_shipped_scene_has_a_golden_record() {
 /// The 3D concrete scenes run 1–6 min each on this 2-core machine, beyond the
 /// suite's budget: their records are benchmarks/RESULTS.md's ("Concrete in 3D", by
 /// `benchmarks/concrete_3d.sh`), and the tension prism's physics is asserted at 15 mm in
-/// `tests/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
+/// `tests/suite/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
 /// random particles (3–4 min a run): its records are RESULTS.md's ("Notched tension prism").
 const LONG: &[&str] = &[
     "beam_3pb_notch02_3d",
@@ -267,16 +271,28 @@ const LONG: &[&str] = &[
 ];
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_elastic_block_3d_on_one_thread() {
     check("elastic_block_3d", "1");
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_dogbone_b() {
     check("dogbone_B", "2");
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_dogbone_d() {
     check("dogbone_D", "2");
 }
@@ -287,11 +303,19 @@ fn golden_dogbone_montecarlo() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_elastic_plate() {
     check("elastic_plate", "2");
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_plate_with_hole() {
     check("plate_with_hole", "2");
 }
@@ -302,6 +326,10 @@ fn golden_split_cylinder() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_split_cylinder_random() {
     check("split_cylinder_random", "2");
 }
@@ -317,16 +345,28 @@ fn golden_uniaxial_tension() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_uniaxial_tension_one_thread() {
     check("uniaxial_tension", "1");
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_uniaxial_tension_random() {
     check("uniaxial_tension_random", "2");
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn golden_uniaxial_tension_random_one_thread() {
     check("uniaxial_tension_random", "1");
 }

@@ -1,5 +1,6 @@
 //! The fast test suite: one test crate (one link) whose modules mirror the topics of src/.
-//! The long physics validations are the `validation` target (`cargo test --release --test validation`).
+//! The long physics validations are ignored here unless the `validation` feature is on
+//! (`cargo test --release --features validation`, which CI runs after the fast suite).
 
 mod cli;
 #[path = "../common/mod.rs"]
@@ -9,6 +10,7 @@ mod concrete_3d;
 mod concrete_input;
 mod cutouts;
 mod damage_law;
+mod docs;
 mod elastic_plate;
 mod fcc;
 mod fcc_kernel;
@@ -22,6 +24,7 @@ mod proptest_scenes;
 mod quasi_static;
 mod random_field;
 mod random_field_scene;
+mod readme;
 mod relaxation;
 mod reliability;
 mod reliability_studies;

@@ -10,7 +10,7 @@ use common::says;
 use common::*;
 use sppm::Scene;
 
-/// The 100 mm tension block of tests/relaxation.rs: every increment converges (the implicit
+/// The 100 mm tension block of tests/suite/relaxation.rs: every increment converges (the implicit
 /// secant solver) to a residual below the tolerance, the block cracks through, peaks within
 /// docs/validation.md §B's 5% of f't·A (measured 0.963) and dissipates G_f·A within its 10%
 /// (measured 0.986). Without the cut-back of increments in which damage jumps
@@ -58,7 +58,7 @@ fn quasi_static_tension_block_converges_and_reaches_ft_and_gf() {
 /// Without damage there is no state to commit: the secant iterations are the relaxation's
 /// iterations (with c kept where Kilic & Madenci's quotient is not positive), so the elastic
 /// plate converges to the same answer: both within tolerance 1e-5 of equilibrium, whose
-/// reaction error is 3–6 × the tolerance (tests/relaxation.rs), so within 1e-4 of each other.
+/// reaction error is 3–6 × the tolerance (tests/suite/relaxation.rs), so within 1e-4 of each other.
 #[test]
 fn elastic_plate_quasi_static_equals_relaxation() {
     let mut text = plate_toml(0.1, 0.2, 0.004, 0.0, "stress", false, 0.2);

@@ -193,11 +193,19 @@ fn check_correlation(kernel: Correlation) {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn exponential_field_correlation_matches_at_several_lags() {
     check_correlation(Correlation::Exponential);
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn squared_exponential_field_correlation_matches_at_several_lags() {
     check_correlation(Correlation::SquaredExponential);
 }
@@ -376,7 +384,7 @@ fn bad_parameters_give_clear_errors() {
 }
 
 /// Generation time and clipped spectrum for dog-bones B and F (not a test: prints figures).
-/// `cargo test --release --test random_field -- --ignored --nocapture`
+/// `cargo test --release --test suite -- --ignored --nocapture random_field::measure_generation`
 #[test]
 #[ignore]
 fn measure_generation() {

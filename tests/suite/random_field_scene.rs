@@ -3,7 +3,7 @@
 //! field at a point does not depend on the lattice spacing, a seed reproduces the field, the
 //! particles' values have the target statistics, and bad tables are refused with the key.
 //! (The field generator's own statistics, correlation and seed tests are in
-//! tests/random_field.rs.)
+//! tests/suite/random_field.rs.)
 
 use crate::common;
 use common::tension_block;

@@ -10,7 +10,7 @@ use common::*;
 use sppm::run::prepare_model;
 use sppm::Scene;
 
-/// The plate of tests/run_plate.rs (L0 = 4 mm, ε = 1e-4) under relaxation.
+/// The plate of tests/suite/run_plate.rs (L0 = 4 mm, ε = 1e-4) under relaxation.
 fn plate(settings: &[&str]) -> Scene {
     let mut text = plate_toml(0.1, 0.2, 0.004, 0.0, "stress", false, 0.2);
     text.push_str("[output]\nmap = false\nvtk = false\n");
@@ -55,7 +55,7 @@ fn relaxed_plate_reaches_the_static_solution_within_its_tolerance() {
         );
         // From the second increment on, the predictor moves the whole specimen with the
         // grips, so no shock reaches the highest modes and the central-difference energy
-        // balance closes as in the explicit run (tests/run_plate.rs). A single increment
+        // balance closes as in the explicit run (tests/suite/run_plate.rs). A single increment
         // is a jump of the grips alone: measured 1.8e-4 of W, the leapfrog energy error of
         // the shock it sends through the lattice; not asserted.
         if increments > 1 {
@@ -83,10 +83,10 @@ fn relaxation_does_not_depend_on_the_thread_count() {
     assert_eq!(a.displacement, b.displacement);
 }
 
-/// The block of tests/concrete.rs (150 × 100 mm, L0 = 10 mm, Table 1 concrete), pulled by
+/// The block of tests/suite/concrete.rs (150 × 100 mm, L0 = 10 mm, Table 1 concrete), pulled by
 /// 1.5·COD_c under relaxation with the default increments and tolerance: the peak within 5%
 /// of f't·A and the dissipated energy within 10% of G_f·A, as the explicit validation test
-/// asserts (tests/concrete.rs).
+/// asserts (tests/suite/concrete.rs).
 #[test]
 fn relaxed_tension_block_reaches_ft() {
     // After the peak 50 of the 200 increments stop at max_iterations with at most 0.58% of

@@ -436,6 +436,10 @@ fn minor_inputs_are_refused_in_the_scenes_words() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn check_of_a_large_body_reports_its_stages() {
     // 5e4 particles and more: stage lines on stderr while the set-up runs
     let o = sppm(&[

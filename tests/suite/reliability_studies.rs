@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-/// The dog-bone of tests/montecarlo.rs (D0 = 0.1 m, L0 = 8 mm, an f't random field).
+/// The dog-bone of tests/suite/montecarlo.rs (D0 = 0.1 m, L0 = 8 mm, an f't random field).
 const DOGBONE: &str = common::TINY_DOGBONE;
 
 /// The shipped tension block at L0 = 30 mm.

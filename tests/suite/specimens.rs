@@ -93,6 +93,10 @@ fn split_cylinder_peak_crack_and_symmetry() {
 /// narrow section (at least one row of fully cracked particles spanning the width there),
 /// and symmetric about the axis.
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn dogbone_b_peak_and_crack() {
     let scene = Scene::from_file(Path::new("lattices/dogbone_B.toml"), &[]).unwrap();
     let o = run(&scene, &RunOptions::default()).unwrap();

@@ -59,6 +59,10 @@ fn print_random_block_moduli() {
 /// as the mean over 5 particle sets (the table was measured at W/L0 = 20 over other sets;
 /// the spread over sets is 0.4% in E and 0.5% in ν).
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn the_calibrated_random_block_shows_the_input_moduli() {
     let (mut e_sum, mut nu_sum) = (0.0, 0.0);
     for seed in 1..=5 {
@@ -86,7 +90,7 @@ fn the_calibrated_random_block_shows_the_input_moduli() {
 /// Generates `model::sppm_calibration`'s 3D table: for each minimum distance and fitted ν*,
 /// the mean E/E* and ν of a W × W × 2W block (W/L0 = 20, the size the measurement no longer
 /// depends on: 0.851 at 16, 0.854 at 24) over 4 particle sets.
-/// `cargo test --release --test sppm3d -- --ignored --nocapture calibration_table_3d`
+/// `cargo test --release --test suite -- --ignored --nocapture sppm3d::calibration_table_3d`
 /// (`SPPM_CALIBRATE=md` for one minimum distance).
 #[test]
 #[ignore]
@@ -305,6 +309,10 @@ fn study_rows(path: &std::path::Path) -> Vec<std::collections::HashMap<String, S
 /// peak differs). Monte Carlo: each realisation draws its own particle set (different seeds,
 /// different peaks), and σN is the peak over the prism's section.
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn random_3d_scenes_run_in_the_objectivity_and_monte_carlo_studies() {
     let base = std::env::temp_dir().join(format!("sppm-3d-studies-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&base);

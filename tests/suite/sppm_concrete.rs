@@ -41,6 +41,10 @@ fn run_set(name: &str, seed: u64) -> (Scene, Outcome) {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn random_tension_block_peak_energy_and_crack() {
     let (mut peaks, mut energies, mut straight) = (vec![], vec![], 0);
     for seed in 1..=10u64 {
@@ -98,6 +102,10 @@ fn random_tension_block_peak_energy_and_crack() {
 /// of them outside, and within 14 mm; seeds 1–3 here 109.7°, 92.1°, 73.2° and within 13 mm,
 /// peaks +5.6%, +13.9%, −0.2%, mean +6.4%).
 #[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
 fn random_split_cylinder_peak_and_crack() {
     let mut ratios = vec![];
     for seed in 1..=3u64 {

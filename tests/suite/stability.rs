@@ -5,9 +5,9 @@
 //!
 //! Already covered elsewhere, not repeated here: the undamped energy drift of the default
 //! reading over 100 periods and the measured instability threshold against the computed
-//! limit (tests/vibration_and_stability.rs), the unstable CLI run (tests/cli.rs), the
+//! limit (tests/suite/vibration_and_stability.rs), the unstable CLI run (tests/suite/cli.rs), the
 //! memory guard for a very small spacing and the "at least 2 particles" guard for a very
-//! large one (tests/scene_errors.rs), and generated scenes (tests/proptest_scenes.rs).
+//! large one (tests/suite/scene_errors.rs), and generated scenes (tests/suite/proptest_scenes.rs).
 
 use crate::common;
 use common::*;
@@ -185,7 +185,7 @@ fn amplification(w: f64, zeta: f64) -> f64 {
 }
 
 /// The computed limit was measured 1.9–3.6% below the true threshold
-/// (tests/vibration_and_stability.rs).
+/// (tests/suite/vibration_and_stability.rs).
 const LIMIT_GAP: f64 = 1.036;
 
 #[test]

@@ -240,7 +240,7 @@ fn free_faces_carry_no_normal_traction_and_the_far_field_tangential_stress() {
 /// Bodies and lattices symmetric about x = 0 (the split cylinder and the dog-bones at 0°)
 /// get mirror-image
 /// volumes and micro-moduli, bit for bit, so that a symmetric specimen cracks symmetrically
-/// (tests/specimens.rs).
+/// (tests/suite/specimens.rs).
 #[test]
 fn mirror_images_get_the_same_cells_and_moduli() {
     for scene in ["split_cylinder", "dogbone_B", "dogbone_D"] {

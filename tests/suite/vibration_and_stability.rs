@@ -104,7 +104,7 @@ fn fundamental_period_matches_the_bar_and_the_free_vibration() {
     // Axial waves with the lateral strain held at zero, plane stress: σ = E/(1−ν²)·ε; fixed–
     // free: T1 = 4L·√(m'/(E'·W·t)), with m' the lattice's own mass per unit length (its rows
     // alternate 11 and 10 particles on a width of 10·L0, 5% more mass than ρ·W·t: an
-    // O(L0/W) boundary effect that tests/elastic_plate.rs measures on the stiffness side).
+    // O(L0/W) boundary effect that tests/suite/elastic_plate.rs measures on the stiffness side).
     let pitch = 0.5 * 3f64.sqrt() * L0;
     let (ymin, ymax) = p
         .model

@@ -32,7 +32,7 @@
 //! which (i) is (3.8) without damage, (ii) is exactly d·(3.8) when all bonds share one d
 //! (as (3.36) is), (iii) vanishes on a broken bond from both ends, and (iv) derives from the
 //! energy ¼·Σ_i[a·Σ_k L0·d_k·S_k² + b·(Σ_k √d_k·S_k)(Σ_k L0·√d_k·S_k)], so that the energy
-//! balance closes (tests/concrete.rs).
+//! balance closes (tests/suite/concrete.rs).
 //!
 //! The damage law itself (initiation, softening, compressive damage, plasticity) is behind
 //! the `model::damage_law::DamageLaw` trait; the two-spring concrete law

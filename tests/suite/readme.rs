@@ -1,0 +1,140 @@
+//! What the README says about the command line holds: its two set-up commands, the
+//! validation command, the command list, `--help` and `--set`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn readme() -> String {
+    std::fs::read_to_string(root().join("README.md")).unwrap()
+}
+
+fn sppm(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_sppm"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .unwrap()
+}
+
+fn stdout(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The README's set-up block: exactly the two commands, the first running a shipped scene
+/// (whose output folder is output/<its name>/, as the README says) and the second the tests.
+#[test]
+fn the_two_set_up_commands_run_a_shipped_scene_and_the_tests() {
+    let text = readme();
+    let block: Vec<&str> = text
+        .split("```sh\n")
+        .nth(1)
+        .and_then(|b| b.split("```").next())
+        .expect("the README opens a sh block for the set-up")
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .collect();
+    assert_eq!(
+        block,
+        [
+            "cargo run --release -- run lattices/split_cylinder.toml",
+            "cargo test --release"
+        ]
+    );
+    assert!(text.contains("`output/split_cylinder/`"));
+    let scene = sppm::Scene::from_file(&root().join("lattices/split_cylinder.toml"), &[]).unwrap();
+    assert_eq!(scene.name(), "split_cylinder");
+    // the run itself, into a folder of its own (the default folder is the repository's)
+    let out = std::env::temp_dir().join(format!("sppm-readme-{}", std::process::id()));
+    let o = sppm(&[
+        "run",
+        "lattices/split_cylinder.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--set",
+        "loading.stop_after_peak=0.9",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("summary.json").exists() && out.join("crack_map.svg").exists());
+    std::fs::remove_dir_all(&out).ok();
+}
+
+/// The validation command the README names switches on a feature the package declares, that
+/// feature gates long tests, and CI runs it after the fast suite.
+#[test]
+fn the_validation_command_names_a_feature_ci_runs() {
+    assert!(readme().contains("`cargo test --release --features validation`"));
+    let cargo = std::fs::read_to_string(root().join("Cargo.toml")).unwrap();
+    assert!(
+        cargo.contains("\nvalidation = []"),
+        "Cargo.toml declares the feature"
+    );
+    let gated = std::fs::read_dir(root().join("tests/suite"))
+        .unwrap()
+        .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap())
+        .map(|t| t.matches("not(feature = \"validation\")").count())
+        .sum::<usize>();
+    assert!(gated >= 10, "{gated} tests gated");
+    let ci: String = std::fs::read_to_string(root().join(".ci/run"))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('#'))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let fast = ci
+        .find("cargo test --release 2>&1")
+        .expect("CI runs the fast suite");
+    let long = ci
+        .find("cargo test --release --features validation")
+        .expect("CI runs the validations");
+    assert!(fast < long);
+}
+
+/// The command list: `sppm --help` names the four commands, `sppm study --help` the four
+/// studies, and each command has its own `--help`.
+#[test]
+fn the_commands_the_readme_lists_exist_with_their_help() {
+    let text = readme();
+    let help = stdout(&sppm(&["--help"]));
+    for cmd in ["run", "check", "study", "bench"] {
+        assert!(text.contains(&format!("sppm {cmd}")), "README lists {cmd}");
+        assert!(help.contains(cmd), "sppm --help lists {cmd}: {help}");
+        let o = sppm(&[cmd, "--help"]);
+        assert!(o.status.success(), "sppm {cmd} --help");
+    }
+    assert!(text.contains("objectivity | convergence | montecarlo | merge"));
+    let study = stdout(&sppm(&["study", "--help"]));
+    for s in ["objectivity", "convergence", "montecarlo", "merge"] {
+        assert!(study.contains(s), "sppm study --help lists {s}: {study}");
+    }
+}
+
+/// `--set` changes one scene value without editing the file: `sppm check` shows the value
+/// and that it came from the scene.
+#[test]
+fn set_changes_one_value_without_editing_the_file() {
+    assert!(readme().contains("`--set`"));
+    let scene = Path::new("lattices/split_cylinder.toml");
+    let before = std::fs::read_to_string(root().join(scene)).unwrap();
+    let o = sppm(&[
+        "check",
+        scene.to_str().unwrap(),
+        "--set",
+        "concrete.ft=3.1e6",
+    ]);
+    assert!(o.status.success());
+    let line = stdout(&o)
+        .lines()
+        .find(|l| l.starts_with("ft "))
+        .map(str::to_string)
+        .expect("check lists f't");
+    assert!(
+        line.contains("3.100000e6") && line.contains("scene"),
+        "{line}"
+    );
+    assert_eq!(std::fs::read_to_string(root().join(scene)).unwrap(), before);
+}
