@@ -6,7 +6,7 @@
 #
 #   bash benchmarks/ab.sh OLD_BIN NEW_BIN [RUNS]
 #
-# Extra arguments for both binaries (e.g. --layout csr for NEW only) go in OLD_ARGS / NEW_ARGS.
+# Extra arguments for either binary (e.g. --scalar for NEW only) go in OLD_ARGS / NEW_ARGS.
 set -euo pipefail
 old=${1:?usage: ab.sh OLD_BIN NEW_BIN [RUNS]}
 new=${2:?usage: ab.sh OLD_BIN NEW_BIN [RUNS]}

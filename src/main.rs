@@ -45,36 +45,40 @@ enum Command {
     },
     /// Throughput of the step kernel on a square hexagonal-lattice block or (--dim 3) an FCC
     /// cube (one JSON line).
-    Bench {
-        /// Dimension: 2 (square block of hexagonal lattice) or 3 (cube of FCC lattice,
-        /// 18 neighbours).
-        #[arg(long, default_value_t = 2)]
-        dim: usize,
-        #[arg(long, default_value_t = 100_000)]
-        particles: usize,
-        #[arg(long, default_value_t = 200)]
-        steps: usize,
-        #[arg(long, default_value_t = 1)]
-        threads: usize,
-        /// Kernel: "elastic", "tension" (tensile damage only) or "full" (two-spring damage and
-        /// plasticity; "concrete" is accepted for it).
-        #[arg(long, default_value = "elastic")]
-        model: String,
-        /// Particles: "hexagonal" (the lattice) or "random" (SPPM; slots only; the set-up
-        /// times of placement, Voronoi cells, bonds and moduli are reported too).
-        #[arg(long, default_value = "hexagonal")]
-        lattice: String,
-        /// Run the damage kernels' scalar path instead of their AVX blocks (--model tension
-        /// or full), to measure the two in one binary.
-        #[arg(long)]
-        scalar: bool,
-    },
+    Bench(BenchArgs),
     /// Many runs of one scene: lattice objectivity, convergence with the spacing, Monte Carlo
     /// size effect (and the merge of its shards).
     Study {
         #[command(subcommand)]
         study: sppm::study::cli::StudyCommand,
     },
+}
+
+/// The options of `sppm bench`.
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Dimension: 2 (square block of hexagonal lattice) or 3 (cube of FCC lattice,
+    /// 18 neighbours).
+    #[arg(long, default_value_t = 2)]
+    dim: usize,
+    #[arg(long, default_value_t = 100_000)]
+    particles: usize,
+    #[arg(long, default_value_t = 200)]
+    steps: usize,
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Kernel: "elastic", "tension" (tensile damage only) or "full" (two-spring damage and
+    /// plasticity; "concrete" is accepted for it).
+    #[arg(long, default_value = "elastic")]
+    model: String,
+    /// Particles: "hexagonal" (the lattice) or "random" (SPPM; slots only; the set-up
+    /// times of placement, Voronoi cells, bonds and moduli are reported too).
+    #[arg(long, default_value = "hexagonal")]
+    lattice: String,
+    /// Run the damage kernels' scalar path instead of their AVX blocks (--model tension
+    /// or full), to measure the two in one binary.
+    #[arg(long)]
+    scalar: bool,
 }
 
 /// `sppm check` reports its stages on stderr for bodies of at least this many particles
@@ -119,55 +123,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             set,
             quiet,
             threads,
-        } => {
-            let sc = Scene::from_file(&scene, &set)?;
-            if threads == Some(0) {
-                anyhow::bail!("--threads 0: at least 1 worker thread is needed");
-            }
-            let dir = out.unwrap_or_else(|| PathBuf::from("output").join(sc.name()));
-            // the folder is created, locked and so known to be writable before any compute
-            let _lock = sppm::fsio::FolderLock::acquire(&dir)?;
-            let outcome = sppm::run(
-                &sc,
-                &RunOptions {
-                    progress: !quiet,
-                    threads,
-                },
-            )?;
-            let files = sppm::output::write_all(&outcome, &dir)?;
-            let s = &outcome.summary;
-            if !quiet {
-                say!(
-                    "{}: {} particles, {} bonds, {} steps of {:.4e} s (T1 = {:.4e} s) in {:.2} s on {} threads",
-                    s.scene, s.particles, s.bonds, s.steps, s.dt_s, s.fundamental_period_s, s.wall_time_s, s.threads
-                );
-                say!(
-                    "peak force {:.6e} N at {:.6e} m; max kinetic/internal energy {:.3e}",
-                    s.peak_force_n,
-                    s.displacement_at_peak_m,
-                    s.max_kinetic_to_internal_energy
-                );
-                for f in &files {
-                    say!("wrote {}", f.display());
-                }
-            }
-            if let (Some(k @ 1..), Some(r), false) = (
-                s.unconverged_increments,
-                s.max_final_residual,
-                outcome.failed(),
-            ) {
-                eprintln!(
-                    "warning: {k} of {} load increments stopped at solver.max_iterations with an out-of-balance force up to {r:.3e} × the reactions (accepted by solver.max_residual = {:e})",
-                    s.increments.unwrap_or(0),
-                    sc.solver.max_residual.unwrap_or(sc.solver.tolerance)
-                );
-            }
-            if outcome.failed() {
-                eprintln!("error: {}", s.message.clone().unwrap_or_default());
-                return Ok(ExitCode::from(exit::RUN_FAILED));
-            }
-            Ok(ExitCode::SUCCESS)
-        }
+        } => run_scene(&scene, out, &set, quiet, threads),
         Command::Check { scene, set } => {
             let sc = Scene::from_file(&scene, &set)?;
             let mem = estimated_memory(&sc);
@@ -182,62 +138,123 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             sppm::run::dispatch(&sc, Check { mem, stage: &stage })?;
             Ok(ExitCode::SUCCESS)
         }
-        Command::Bench {
-            dim,
-            particles,
-            steps,
-            threads,
-            model,
-            lattice,
-            scalar,
-        } => {
-            anyhow::ensure!(
-                dim == 2 || dim == 3,
-                "--dim {dim}: 2 (hexagonal lattice) or 3 (FCC lattice)"
-            );
-            let kernel = match model.as_str() {
-                "elastic" => sppm::solver::KernelSet::Elastic,
-                "tension" => sppm::solver::KernelSet::Tension,
-                "full" | "concrete" => sppm::solver::KernelSet::Full,
-                _ => anyhow::bail!(
-                    "--model {model}: \"elastic\", \"tension\" (tensile damage only) or \"full\" (damage and plasticity)"
-                ),
-            };
-            anyhow::ensure!(
-                !scalar || kernel != sppm::solver::KernelSet::Elastic,
-                "--scalar: the scalar path of the damage kernels (--model tension or full); the elastic kernel has no switch"
-            );
-            if dim == 3 {
-                anyhow::ensure!(
-                    ["hexagonal", "fcc", "random"].contains(&lattice.as_str()),
-                    "--lattice {lattice} with --dim 3: \"fcc\" (the FCC lattice) or \"random\" (random particles, elastic kernel)"
-                );
-            }
-            anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
-            sppm::limits::check_count(
-                "--particles",
-                particles as f64,
-                sppm::bench::bytes_per_particle(kernel, dim) as f64,
-                "particles",
-            )?;
-            anyhow::ensure!(threads >= 1, "--threads {threads}: at least 1");
-            anyhow::ensure!(
-                threads <= 4096,
-                "--threads {threads}: at most 4096 worker threads"
-            );
-            let r = if dim == 3 && lattice == "random" {
-                sppm::bench::bench_random3(particles, steps.max(1), threads, kernel)
-            } else if dim == 3 {
-                sppm::bench::bench_fcc(particles, steps.max(1), threads, kernel, !scalar)
-            } else {
-                sppm::bench::bench(particles, steps.max(1), threads, kernel, &lattice, !scalar)
-            }
-            .context("benchmark failed")?;
-            say!("{}", serde_json::to_string(&r)?);
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::Bench(args) => bench(&args),
         Command::Study { study } => sppm::study::cli::dispatch(study),
     }
+}
+
+/// `sppm run`: run a scene and write its outputs into `out` (default output/<scene name>).
+fn run_scene(
+    scene: &std::path::Path,
+    out: Option<PathBuf>,
+    set: &[String],
+    quiet: bool,
+    threads: Option<usize>,
+) -> anyhow::Result<ExitCode> {
+    let sc = Scene::from_file(scene, set)?;
+    if threads == Some(0) {
+        anyhow::bail!("--threads 0: at least 1 worker thread is needed");
+    }
+    let dir = out.unwrap_or_else(|| PathBuf::from("output").join(sc.name()));
+    // the folder is created, locked and so known to be writable before any compute
+    let _lock = sppm::fsio::FolderLock::acquire(&dir)?;
+    let outcome = sppm::run(
+        &sc,
+        &RunOptions {
+            progress: !quiet,
+            threads,
+        },
+    )?;
+    let files = sppm::output::write_all(&outcome, &dir)?;
+    let s = &outcome.summary;
+    if !quiet {
+        say!(
+            "{}: {} particles, {} bonds, {} steps of {:.4e} s (T1 = {:.4e} s) in {:.2} s on {} threads",
+            s.scene, s.particles, s.bonds, s.steps, s.dt_s, s.fundamental_period_s, s.wall_time_s, s.threads
+        );
+        say!(
+            "peak force {:.6e} N at {:.6e} m; max kinetic/internal energy {:.3e}",
+            s.peak_force_n,
+            s.displacement_at_peak_m,
+            s.max_kinetic_to_internal_energy
+        );
+        for f in &files {
+            say!("wrote {}", f.display());
+        }
+    }
+    if let (Some(k @ 1..), Some(r), false) = (
+        s.unconverged_increments,
+        s.max_final_residual,
+        outcome.failed(),
+    ) {
+        eprintln!(
+            "warning: {k} of {} load increments stopped at solver.max_iterations with an out-of-balance force up to {r:.3e} × the reactions (accepted by solver.max_residual = {:e})",
+            s.increments.unwrap_or(0),
+            sc.solver.max_residual.unwrap_or(sc.solver.tolerance)
+        );
+    }
+    if outcome.failed() {
+        eprintln!("error: {}", s.message.clone().unwrap_or_default());
+        return Ok(ExitCode::from(exit::RUN_FAILED));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `sppm bench`: the step kernel's throughput, one JSON line.
+fn bench(args: &BenchArgs) -> anyhow::Result<ExitCode> {
+    let BenchArgs {
+        dim,
+        particles,
+        steps,
+        threads,
+        ref model,
+        ref lattice,
+        scalar,
+    } = *args;
+    anyhow::ensure!(
+        dim == 2 || dim == 3,
+        "--dim {dim}: 2 (hexagonal lattice) or 3 (FCC lattice)"
+    );
+    let kernel = match model.as_str() {
+        "elastic" => sppm::solver::KernelSet::Elastic,
+        "tension" => sppm::solver::KernelSet::Tension,
+        "full" | "concrete" => sppm::solver::KernelSet::Full,
+        _ => anyhow::bail!(
+            "--model {model}: \"elastic\", \"tension\" (tensile damage only) or \"full\" (damage and plasticity)"
+        ),
+    };
+    anyhow::ensure!(
+        !scalar || kernel != sppm::solver::KernelSet::Elastic,
+        "--scalar: the scalar path of the damage kernels (--model tension or full); the elastic kernel has no switch"
+    );
+    if dim == 3 {
+        anyhow::ensure!(
+            ["hexagonal", "fcc", "random"].contains(&lattice.as_str()),
+            "--lattice {lattice} with --dim 3: \"fcc\" (the FCC lattice) or \"random\" (random particles, elastic kernel)"
+        );
+    }
+    anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
+    sppm::limits::check_count(
+        "--particles",
+        particles as f64,
+        sppm::bench::bytes_per_particle(kernel, dim) as f64,
+        "particles",
+    )?;
+    anyhow::ensure!(threads >= 1, "--threads {threads}: at least 1");
+    anyhow::ensure!(
+        threads <= 4096,
+        "--threads {threads}: at most 4096 worker threads"
+    );
+    let r = if dim == 3 && lattice == "random" {
+        sppm::bench::bench_random3(particles, steps.max(1), threads, kernel)
+    } else if dim == 3 {
+        sppm::bench::bench_fcc(particles, steps.max(1), threads, kernel, !scalar)
+    } else {
+        sppm::bench::bench(particles, steps.max(1), threads, kernel, lattice, !scalar)
+    }
+    .context("benchmark failed")?;
+    say!("{}", serde_json::to_string(&r)?);
+    Ok(ExitCode::SUCCESS)
 }
 
 /// `sppm check` of a scene with its generator: the body, groups, T1, time step, memory and

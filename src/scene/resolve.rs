@@ -32,35 +32,60 @@ fn positive_opt(key: &str, v: Option<f64>) -> Result<(), SceneError> {
     }
 }
 
+/// The strengths and fracture energy of a concrete scene, as given or derived.
+struct Strengths {
+    fc: f64,
+    e: f64,
+    ft: f64,
+    fy: f64,
+    fult: f64,
+    gf: f64,
+}
+
 impl Scene {
     /// Fill every derived value (see the module docs). Called by [`Scene::from_toml_str`]
     /// before [`Scene::validate`].
     pub fn resolve(&mut self) -> Result<(), SceneError> {
         self.derived.clear();
-        let rho = self.material.rho;
         let Some(c) = self.concrete.clone() else {
-            let Some(e) = self.material.e else {
-                return Err(invalid(
-                    "material.E",
-                    "(missing)",
-                    "give Young's modulus E in Pa, or a [concrete] section to derive it from f'c and rho (ACI 318-14)",
-                ));
-            };
-            self.record("E", e, "scene");
-            for (gi, g) in self.groups.iter().enumerate() {
-                if let Some(l) = &g.load {
-                    if l.displacement.is_none() {
-                        return Err(invalid(
-                            format!("groups[{gi}].load.displacement"),
-                            "(missing)",
-                            "give the displacement at the end of the ramp in m (it defaults to 1.5·COD_c only in a scene with [concrete])",
-                        ));
-                    }
+            return self.resolve_elastic();
+        };
+        self.check_concrete_inputs(&c)?;
+        let s = self.resolve_strengths(&c)?;
+        self.check_concrete_law(&c, &s)?;
+        let cod_c = cc::critical_crack_opening(s.gf, s.ft, c.alpha, c.gamma);
+        self.record("COD_c", cod_c, "2·Gf/(f't·(alpha+gamma)) (5.4)");
+        self.resolve_crack_band(&c, &s, cod_c)?;
+        self.default_displacements(cod_c);
+        Ok(())
+    }
+
+    /// A scene without `[concrete]`: E and every loaded group's displacement are given.
+    fn resolve_elastic(&mut self) -> Result<(), SceneError> {
+        let Some(e) = self.material.e else {
+            return Err(invalid(
+                "material.E",
+                "(missing)",
+                "give Young's modulus E in Pa, or a [concrete] section to derive it from f'c and rho (ACI 318-14)",
+            ));
+        };
+        self.record("E", e, "scene");
+        for (gi, g) in self.groups.iter().enumerate() {
+            if let Some(l) = &g.load {
+                if l.displacement.is_none() {
+                    return Err(invalid(
+                        format!("groups[{gi}].load.displacement"),
+                        "(missing)",
+                        "give the displacement at the end of the ramp in m (it defaults to 1.5·COD_c only in a scene with [concrete])",
+                    ));
                 }
             }
-            return Ok(());
-        };
-        // Raw inputs first, as written.
+        }
+        Ok(())
+    }
+
+    /// The raw inputs of the correlations, as written.
+    fn check_concrete_inputs(&self, c: &ConcreteSpec) -> Result<(), SceneError> {
         for (key, v) in [
             ("concrete.fc", c.fc),
             ("concrete.ft", c.ft),
@@ -73,6 +98,7 @@ impl Scene {
         ] {
             positive_opt(key, v)?;
         }
+        let rho = self.material.rho;
         if !(rho.is_finite() && rho > 0.0) {
             return Err(invalid(
                 "material.rho",
@@ -80,6 +106,13 @@ impl Scene {
                 "must be a finite number greater than zero",
             ));
         }
+        Ok(())
+    }
+
+    /// f'c, E, f't, f_y, f_ult and G_f: each given, else from the preset, else from its
+    /// correlation (docs/model.md §11); E is set in `[material]`.
+    fn resolve_strengths(&mut self, c: &ConcreteSpec) -> Result<Strengths, SceneError> {
+        let rho = self.material.rho;
         // (f'c, d_max, f't) of the preset, with its source
         let preset = c
             .preset
@@ -132,7 +165,18 @@ impl Scene {
                 "CEB-FIP 1990: Gf = Gf0·((f'c + 8 MPa)/10 MPa)^0.7 (5.3)".into(),
             ))
         })?;
-        // Ranges of the law's parameters.
+        Ok(Strengths {
+            fc,
+            e,
+            ft,
+            fy,
+            fult,
+            gf,
+        })
+    }
+
+    /// The ranges of the law's parameters, and strengths in order.
+    fn check_concrete_law(&self, c: &ConcreteSpec, s: &Strengths) -> Result<(), SceneError> {
         let frac = |key: &str, v: f64, lo_open: bool| -> Result<(), SceneError> {
             let ok = v.is_finite() && v < 1.0 && if lo_open { v > 0.0 } else { v >= 0.0 };
             if ok {
@@ -179,26 +223,64 @@ impl Scene {
                 "at least -0.8 in a scene with concrete plasticity (the explicit plastic flow diverges as nu approaches -1); or set concrete.plasticity = false",
             ));
         }
-        if ft >= fc {
+        if s.ft >= s.fc {
             return Err(invalid(
                 "concrete.ft",
-                ft,
-                format!("must be below f'c = {fc:e} Pa"),
+                s.ft,
+                format!("must be below f'c = {:e} Pa", s.fc),
             ));
         }
-        if fy > fult {
+        if s.fy > s.fult {
             return Err(invalid(
                 "concrete.fy",
-                fy,
-                format!("must not exceed f_ult = {fult:e} Pa"),
+                s.fy,
+                format!("must not exceed f_ult = {:e} Pa", s.fult),
             ));
         }
-        let cod_c = cc::critical_crack_opening(gf, ft, c.alpha, c.gamma);
-        self.record("COD_c", cod_c, "2·Gf/(f't·(alpha+gamma)) (5.4)");
-        // The crack opening of a particle at initiation, 2·L0·f't/E (4.13): the softening law
-        // needs room beyond it.
+        Ok(())
+    }
+
+    /// The crack band (given, else the default of the discretisation), set in `[concrete]`;
+    /// COD_c must exceed the crack opening of a particle at initiation, crack_band·L0·f't/E
+    /// (4.13): the softening law needs room beyond it.
+    fn resolve_crack_band(
+        &mut self,
+        c: &ConcreteSpec,
+        s: &Strengths,
+        cod_c: f64,
+    ) -> Result<(), SceneError> {
         let l0 = self.discretisation.spacing;
-        let (default, source) = if self.dim() == 3 && self.discretisation.is_random() {
+        let (default, source) = self.default_crack_band();
+        let band = self.take("concrete.crack_band", c.crack_band, |_| {
+            Ok((default, source.into()))
+        })?;
+        if !(band.is_finite() && band > 0.0 && band <= 10.0) {
+            return Err(invalid(
+                "concrete.crack_band",
+                band,
+                "must satisfy 0 < crack_band <= 10 (a multiple of the lattice spacing)",
+            ));
+        }
+        if let Some(cs) = self.concrete.as_mut() {
+            cs.crack_band = Some(band);
+        }
+        let cod_el = band * l0 * s.ft / s.e;
+        if l0.is_finite() && l0 > 0.0 && cod_c <= cod_el {
+            let gf_min = cod_el * s.ft * (c.alpha + c.gamma) / 2.0;
+            return Err(invalid(
+                "concrete.Gf",
+                format!("{:.4} N/m", s.gf),
+                format!(
+                    "gives COD_c = {cod_c:.3e} m, not above the elastic crack opening crack_band·L0·f't/E = {cod_el:.3e} m of this lattice spacing; Gf must exceed {gf_min:.4} N/m, or use a smaller discretisation.spacing"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The measured crack band of the scene's discretisation, and where it was measured.
+    fn default_crack_band(&self) -> (f64, &'static str) {
+        if self.dim() == 3 && self.discretisation.is_random() {
             (
                 RANDOM_3D_CRACK_BAND,
                 "random 3D particles' default (benchmarks/RESULTS.md, \"Random particles in 3D\")",
@@ -218,31 +300,11 @@ impl Scene {
                 LATTICE_CRACK_BAND,
                 "lattices' default (benchmarks/RESULTS.md, \"Concrete in 2D\")",
             )
-        };
-        let band = self.take("concrete.crack_band", c.crack_band, |_| {
-            Ok((default, source.into()))
-        })?;
-        if !(band.is_finite() && band > 0.0 && band <= 10.0) {
-            return Err(invalid(
-                "concrete.crack_band",
-                band,
-                "must satisfy 0 < crack_band <= 10 (a multiple of the lattice spacing)",
-            ));
         }
-        if let Some(cs) = self.concrete.as_mut() {
-            cs.crack_band = Some(band);
-        }
-        let cod_el = band * l0 * ft / e;
-        if l0.is_finite() && l0 > 0.0 && cod_c <= cod_el {
-            let gf_min = cod_el * ft * (c.alpha + c.gamma) / 2.0;
-            return Err(invalid(
-                "concrete.Gf",
-                format!("{gf:.4} N/m"),
-                format!(
-                    "gives COD_c = {cod_c:.3e} m, not above the elastic crack opening crack_band·L0·f't/E = {cod_el:.3e} m of this lattice spacing; Gf must exceed {gf_min:.4} N/m, or use a smaller discretisation.spacing"
-                ),
-            ));
-        }
+    }
+
+    /// Δmax of every loaded group that gives none: 1.5·COD_c in tension (docs/model.md §10).
+    fn default_displacements(&mut self, cod_c: f64) {
         for gi in 0..self.groups.len() {
             if let Some(l) = &mut self.groups[gi].load {
                 if l.displacement.is_none() {
@@ -256,7 +318,6 @@ impl Scene {
                 }
             }
         }
-        Ok(())
     }
 
     /// The value the scene gives for `key`, else the one `derive` finds (with its source);

@@ -276,58 +276,17 @@ pub fn label(angle_deg: f64, k: usize) -> String {
 /// Run (or resume) the study and write objectivity.csv, objectivity.json and
 /// force_displacement_overlay.svg into the study folder.
 pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> {
-    if args.angles_deg.is_empty() {
-        bail!("--angles: give at least one angle in degrees, e.g. --angles 0,15,30,45");
-    }
-    if let Some(a) = args.angles_deg.iter().find(|a| !a.is_finite()) {
-        bail!("--angles: {a} is not an angle in degrees");
-    }
-    for (i, a) in args.angles_deg.iter().enumerate() {
-        if args.angles_deg[..i].contains(a) {
-            bail!("--angles: {a} appears twice");
-        }
-    }
-    if args.jobs == 0 {
-        bail!("--jobs 0: at least 1");
-    }
-    if !(args.crack_damage > 0.0 && args.crack_damage <= 1.0) {
-        bail!(
-            "--crack-damage {}: a tensile damage w_t with 0 < w_t <= 1",
-            args.crack_damage
-        );
-    }
+    check_options(args)?;
     let base = Scene::from_file(&args.scene, &args.overrides)?;
     let d = &base.discretisation;
     let three = base.dim() == 3;
-    // the index in rotation_deg = [α, β, γ], the angles about z, y and x
-    let axis = match (args.axis, three) {
-        ('z', _) => 0,
-        ('y', true) => 1,
-        ('x', true) => 2,
-        (a, true) => bail!("--axis {a}: x, y or z"),
-        (a, false) => {
-            bail!("--axis {a}: z (or absent) for a 2D scene, whose lattice turns in its plane")
-        }
-    };
+    let axis = rotation_axis(args.axis, three)?;
     if three && !d.is_random() && args.offsets > 0 {
         bail!(
             "--offsets {}: 0 for the FCC lattice (random offsets of a 3D lattice are not drawn yet; use lattice = \"random\" for realisations)",
             args.offsets
         );
     }
-    // the rotation override: one angle in 2D, three in 3D (the angle about `axis`)
-    let rotation = move |a: f64| {
-        if three {
-            let mut r = [0.0; 3];
-            r[axis] = a;
-            format!(
-                "discretisation.rotation_deg=[{:?}, {:?}, {:?}]",
-                r[0], r[1], r[2]
-            )
-        } else {
-            format!("discretisation.rotation_deg={a:?}")
-        }
-    };
     let dir = args
         .out
         .clone()
@@ -335,33 +294,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     // runs: angle-major, offset 0 (the scene's own) then the random ones; made when taken
     let per_angle_runs = args.offsets as u128 + 1;
     let count = args.angles_deg.len() as u128 * per_angle_runs;
-    let spacing = d.spacing;
-    let scene_offset = d.offset2();
-    // random particles: "offset" k is realisation k, a particle set of its own seed (k = 0:
-    // the scene's seed), turned by the angle
-    let random = d.is_random();
-    let scene_seed = crate::discretise::random::RandomParticles::of_scene(&base).seed;
-    let make = |j: usize| {
-        let (i, k) = (j as u128 / per_angle_runs, j as u128 % per_angle_runs);
-        let (a, k) = (args.angles_deg[i as usize], k as usize);
-        if random {
-            let seed = realisation_seed(args.seed, scene_seed, k);
-            return Variant {
-                label: label(a, k),
-                overrides: vec![rotation(a), format!("seed={seed}")],
-                tags: vec![a.to_string(), k.to_string(), seed.to_string()],
-            };
-        }
-        let off = lattice_offset(args.seed, k, a, spacing, scene_offset);
-        Variant {
-            label: label(a, k),
-            overrides: vec![
-                rotation(a),
-                format!("discretisation.offset=[{:?}, {:?}]", off[0], off[1]),
-            ],
-            tags: vec![a.to_string(), k.to_string(), args.seed.to_string()],
-        }
-    };
+    let make = variants(args, &base, three, axis);
     let threshold = args.crack_damage;
     let metrics = move |o: &Outcome| crack_metrics(o, threshold);
     let study = Study {
@@ -429,18 +362,112 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
             )
         },
     )?;
-    let metric = |r: &RunResult, name: &str| {
-        let i = CRACK_COLUMNS.iter().position(|c| *c == name).unwrap();
-        r.row.metrics[i]
-    };
-    let mean_of = |v: Vec<f64>| {
-        let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
-        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-    };
-    let cov_of = |v: Vec<f64>| {
-        let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
-        (v.len() >= 2).then(|| super::size_effect::sample(&v).cov)
-    };
+    let report = report(args, &base, dir, &results);
+    crate::fsio::write_json(&report.dir.join("objectivity.json"), &report)?;
+    drop(lock);
+    Ok(report)
+}
+
+/// The options that need no scene: distinct finite angles, jobs and the crack threshold.
+fn check_options(args: &ObjectivityArgs) -> anyhow::Result<()> {
+    if args.angles_deg.is_empty() {
+        bail!("--angles: give at least one angle in degrees, e.g. --angles 0,15,30,45");
+    }
+    if let Some(a) = args.angles_deg.iter().find(|a| !a.is_finite()) {
+        bail!("--angles: {a} is not an angle in degrees");
+    }
+    for (i, a) in args.angles_deg.iter().enumerate() {
+        if args.angles_deg[..i].contains(a) {
+            bail!("--angles: {a} appears twice");
+        }
+    }
+    if args.jobs == 0 {
+        bail!("--jobs 0: at least 1");
+    }
+    if !(args.crack_damage > 0.0 && args.crack_damage <= 1.0) {
+        bail!(
+            "--crack-damage {}: a tensile damage w_t with 0 < w_t <= 1",
+            args.crack_damage
+        );
+    }
+    Ok(())
+}
+
+/// The index of `--axis` in rotation_deg = [α, β, γ], the angles about z, y and x (only z in
+/// 2D).
+fn rotation_axis(axis: char, three: bool) -> anyhow::Result<usize> {
+    Ok(match (axis, three) {
+        ('z', _) => 0,
+        ('y', true) => 1,
+        ('x', true) => 2,
+        (a, true) => bail!("--axis {a}: x, y or z"),
+        (a, false) => {
+            bail!("--axis {a}: z (or absent) for a 2D scene, whose lattice turns in its plane")
+        }
+    })
+}
+
+/// The rotation override of angle `a`: one angle in 2D, three in 3D (the angle about `axis`).
+fn rotation_override(a: f64, three: bool, axis: usize) -> String {
+    if three {
+        let mut r = [0.0; 3];
+        r[axis] = a;
+        format!(
+            "discretisation.rotation_deg=[{:?}, {:?}, {:?}]",
+            r[0], r[1], r[2]
+        )
+    } else {
+        format!("discretisation.rotation_deg={a:?}")
+    }
+}
+
+/// Run `j` of the study (angle-major, offset 0 the scene's own then the random ones), made
+/// when it is taken. On random particles "offset" k is realisation k, a particle set of its
+/// own seed (k = 0: the scene's seed), turned by the angle.
+fn variants<'a>(
+    args: &'a ObjectivityArgs,
+    base: &Scene,
+    three: bool,
+    axis: usize,
+) -> impl Fn(usize) -> Variant + Sync + 'a {
+    let d = &base.discretisation;
+    let per_angle_runs = args.offsets as u128 + 1;
+    let spacing = d.spacing;
+    let scene_offset = d.offset2();
+    let random = d.is_random();
+    let scene_seed = crate::discretise::random::RandomParticles::of_scene(base).seed;
+    move |j: usize| {
+        let (i, k) = (j as u128 / per_angle_runs, j as u128 % per_angle_runs);
+        let (a, k) = (args.angles_deg[i as usize], k as usize);
+        let rotation = rotation_override(a, three, axis);
+        if random {
+            let seed = realisation_seed(args.seed, scene_seed, k);
+            return Variant {
+                label: label(a, k),
+                overrides: vec![rotation, format!("seed={seed}")],
+                tags: vec![a.to_string(), k.to_string(), seed.to_string()],
+            };
+        }
+        let off = lattice_offset(args.seed, k, a, spacing, scene_offset);
+        Variant {
+            label: label(a, k),
+            overrides: vec![
+                rotation,
+                format!("discretisation.offset=[{:?}, {:?}]", off[0], off[1]),
+            ],
+            tags: vec![a.to_string(), k.to_string(), args.seed.to_string()],
+        }
+    }
+}
+
+/// objectivity.json of the study's results: the spreads, the per-angle means and the
+/// angle effect.
+fn report(
+    args: &ObjectivityArgs,
+    base: &Scene,
+    dir: PathBuf,
+    results: &[RunResult],
+) -> ObjectivityReport {
     // the completed runs of each angle, in the order of `angles_deg`
     let by_angle: Vec<Vec<&RunResult>> = args
         .angles_deg
@@ -450,38 +477,6 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
                 .iter()
                 .filter(|r| r.row.completed() && r.row.rotation_deg == a)
                 .collect()
-        })
-        .collect();
-    let per_angle = args
-        .angles_deg
-        .iter()
-        .zip(&by_angle)
-        .map(|(&a, rs)| AngleSummary {
-            angle_deg: a,
-            runs: rs.len(),
-            mean_peak_force_n: mean_of(rs.iter().map(|r| r.row.peak_force_n).collect())
-                .unwrap_or(f64::NAN),
-            mean_dissipated_energy_j: mean_of(
-                rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
-            )
-            .unwrap_or(f64::NAN),
-            cov_peak_force: cov_of(rs.iter().map(|r| r.row.peak_force_n).collect()),
-            cov_dissipated_energy: cov_of(rs.iter().map(|r| r.row.dissipated_energy_j).collect()),
-            mean_crack_axis_deg: mean_axis_deg(
-                &rs.iter()
-                    .map(|r| metric(r, "crack_axis_deg"))
-                    .filter(|a| a.is_finite())
-                    .collect::<Vec<_>>(),
-            ),
-            mean_crack_centroid_x_m: mean_of(
-                rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
-            ),
-            mean_crack_core_axis_deg: mean_axis_deg(
-                &rs.iter()
-                    .map(|r| metric(r, "crack_core_axis_deg"))
-                    .filter(|a| a.is_finite())
-                    .collect::<Vec<_>>(),
-            ),
         })
         .collect();
     let groups = |value: fn(&RunResult) -> f64| -> Vec<Vec<f64>> {
@@ -498,7 +493,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     let peak_force_angle_effect = angle_effect(&groups(|r| r.row.peak_force_n), args.seed);
     let dissipated_energy_angle_effect =
         angle_effect(&groups(|r| r.row.dissipated_energy_j), args.seed);
-    let report = ObjectivityReport {
+    ObjectivityReport {
         scene: base.name().to_string(),
         scene_file: args.scene.display().to_string(),
         overrides: args.overrides.clone(),
@@ -508,17 +503,60 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         crack_damage: args.crack_damage,
         runs: results.len(),
         completed: results.iter().filter(|r| r.row.completed()).count(),
-        peak_force: spread(&results, |r| r.row.peak_force_n),
-        dissipated_energy: spread(&results, |r| r.row.dissipated_energy_j),
-        per_angle,
+        peak_force: spread(results, |r| r.row.peak_force_n),
+        dissipated_energy: spread(results, |r| r.row.dissipated_energy_j),
+        per_angle: per_angle(&args.angles_deg, &by_angle),
         peak_force_angle_effect,
         dissipated_energy_angle_effect,
         rows: results.iter().map(|r| r.row.clone()).collect(),
-        dir: dir.clone(),
+        dir,
+    }
+}
+
+/// The per-angle means over the offsets of the completed runs of each angle (`by_angle`, in
+/// the order of `angles`).
+fn per_angle(angles: &[f64], by_angle: &[Vec<&RunResult>]) -> Vec<AngleSummary> {
+    let metric = |r: &RunResult, name: &str| {
+        let i = CRACK_COLUMNS.iter().position(|c| *c == name).unwrap();
+        r.row.metrics[i]
     };
-    crate::fsio::write_json(&dir.join("objectivity.json"), &report)?;
-    drop(lock);
-    Ok(report)
+    let mean_of = |v: Vec<f64>| {
+        let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
+    let cov_of = |v: Vec<f64>| {
+        let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+        (v.len() >= 2).then(|| super::size_effect::sample(&v).cov)
+    };
+    let axis_of = |rs: &[&RunResult], name: &str| {
+        mean_axis_deg(
+            &rs.iter()
+                .map(|r| metric(r, name))
+                .filter(|a| a.is_finite())
+                .collect::<Vec<_>>(),
+        )
+    };
+    angles
+        .iter()
+        .zip(by_angle)
+        .map(|(&a, rs)| AngleSummary {
+            angle_deg: a,
+            runs: rs.len(),
+            mean_peak_force_n: mean_of(rs.iter().map(|r| r.row.peak_force_n).collect())
+                .unwrap_or(f64::NAN),
+            mean_dissipated_energy_j: mean_of(
+                rs.iter().map(|r| r.row.dissipated_energy_j).collect(),
+            )
+            .unwrap_or(f64::NAN),
+            cov_peak_force: cov_of(rs.iter().map(|r| r.row.peak_force_n).collect()),
+            cov_dissipated_energy: cov_of(rs.iter().map(|r| r.row.dissipated_energy_j).collect()),
+            mean_crack_axis_deg: axis_of(rs, "crack_axis_deg"),
+            mean_crack_centroid_x_m: mean_of(
+                rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
+            ),
+            mean_crack_core_axis_deg: axis_of(rs, "crack_core_axis_deg"),
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -64,7 +64,10 @@ fn cited_sections(text: &str, prefix: &str) -> Vec<String> {
             // a range "§6–9", "§B–C" or "§A–§C": its end is a label too
             if let Some(r) = rest.strip_prefix('–') {
                 let r = r.strip_prefix('§').unwrap_or(r);
-                let end: String = r.chars().take_while(|c| c.is_ascii_alphanumeric()).collect();
+                let end: String = r
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric())
+                    .collect();
                 out.push(end.clone());
                 rest = &r[end.len()..];
             }

@@ -754,7 +754,7 @@ safety = 0.4897296086666986
     assert_eq!(run_quiet(&scene).summary.status, "completed");
 }
 
-/// Bug 4 (no validation, src/scene/validate.rs): a load displacement of 1e300 m overflowed
+/// Bug 4 (no validation, src/scene/validate/groups.rs): a load displacement of 1e300 m overflowed
 /// the energies to NaN at step 1. A displacement beyond the body's smallest dimension is now
 /// refused.
 #[test]

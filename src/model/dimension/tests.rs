@@ -88,14 +88,14 @@ mod reference {
         (sx * sx - sx * sy + sy * sy + 3.0 * txy * txy).sqrt()
     }
 
-    /// The criteria of `solver/concrete.rs` before the refactor.
+    /// The criteria of the damage kernel before the refactor.
     pub fn extremes(s: &Matrix2<f64>, nu: f64, plane: Plane) -> (f64, f64) {
         let (s1, s2) = principal_values(s);
         let s33 = out_of_plane_stress(s1, s2, nu, plane);
         (s1.max(s33), s2.min(s33))
     }
 
-    /// D·ε of `solver/concrete.rs` before the refactor.
+    /// D·ε of the damage kernel before the refactor.
     pub fn stress_of_strain(d: &Matrix3<f64>, eps_d: &Matrix2<f64>) -> Matrix2<f64> {
         let sv = d * Vector3::new(eps_d[(0, 0)], eps_d[(1, 1)], 2.0 * eps_d[(0, 1)]);
         Matrix2::new(sv[0], sv[2], sv[2], sv[1])

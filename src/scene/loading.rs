@@ -1,0 +1,95 @@
+//! `[loading]` and `[damping]`: the time history of the displacement loading
+//! (docs/model.md §10) and the damping ratios (docs/model.md §5).
+
+use super::Axis;
+use serde::{Deserialize, Serialize};
+
+/// Displacement loading of one component of a group.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Loaded component: "x" or "y".
+    pub component: Axis,
+    /// Δmax (m): the displacement at the end of the ramp (signed). May be left out in a
+    /// scene with `[concrete]`: it then defaults to +1.5·COD_c (tension, docs/model.md §10).
+    /// Always set after [`Scene::resolve`](super::Scene::resolve).
+    #[serde(default)]
+    pub displacement: Option<f64>,
+}
+
+impl LoadSpec {
+    /// Δmax (m) after [`Scene::resolve`](super::Scene::resolve).
+    pub fn delta(&self) -> f64 {
+        self.displacement.unwrap_or(f64::NAN)
+    }
+}
+
+/// Time history of the displacement loading (docs/model.md §10).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadingSpec {
+    /// "cosine" (5.5) or "smoothstep" (Hobbs (2021), Eq. 4.9).
+    #[serde(default = "default_ramp")]
+    pub ramp: Ramp,
+    /// t_ramp / t_end (5.5 uses 0.8).
+    #[serde(default = "default_ramp_fraction")]
+    pub ramp_fraction: f64,
+    /// t_end as a multiple of the computed fundamental period T1.
+    #[serde(default)]
+    pub end_periods: Option<f64>,
+    /// t_end in seconds (instead of end_periods).
+    #[serde(default)]
+    pub end_s: Option<f64>,
+    /// Stop the run once, after the peak, the probe force has fallen below this fraction of
+    /// the peak and a particle has failed (w_t or w_c ≥ 0.99); scenes with `[concrete]`.
+    #[serde(default)]
+    pub stop_after_peak: Option<f64>,
+}
+
+impl Default for LoadingSpec {
+    fn default() -> Self {
+        LoadingSpec {
+            ramp: default_ramp(),
+            ramp_fraction: default_ramp_fraction(),
+            end_periods: None,
+            end_s: None,
+            stop_after_peak: None,
+        }
+    }
+}
+
+/// Ramp shapes.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Ramp {
+    Cosine,
+    Smoothstep,
+}
+
+fn default_ramp() -> Ramp {
+    Ramp::Cosine
+}
+fn default_ramp_fraction() -> f64 {
+    0.8
+}
+
+/// Damping ratios (docs/model.md §5).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DampingSpec {
+    /// ξ_in, bond dampers (3.55).
+    #[serde(default)]
+    pub internal: f64,
+    /// ξ_ex, particle-velocity dampers on the fundamental mode (3.56).
+    #[serde(default)]
+    pub external: f64,
+}
+
+impl Default for DampingSpec {
+    fn default() -> Self {
+        DampingSpec {
+            internal: 0.0,
+            external: 0.0,
+        }
+    }
+}

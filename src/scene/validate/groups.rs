@@ -1,0 +1,178 @@
+//! `[[groups]]`: unique names, selections of the scene's dimension, and supports and loads on
+//! axes it has.
+
+use super::{finite, invalid, positive, SceneError};
+use crate::scene::{Edge, GroupSpec, Scene, Selection};
+use std::collections::HashSet;
+
+impl Scene {
+    pub(super) fn validate_groups(&self) -> Result<(), SceneError> {
+        let mut names = HashSet::new();
+        for (gi, g) in self.groups.iter().enumerate() {
+            let key = format!("groups[{gi}]");
+            if g.name.is_empty() {
+                return Err(invalid(
+                    format!("{key}.name"),
+                    "\"\"",
+                    "a non-empty group name",
+                ));
+            }
+            if !names.insert(g.name.clone()) {
+                return Err(invalid(
+                    format!("{key}.name"),
+                    format!("{:?}", g.name),
+                    "group names must be unique",
+                ));
+            }
+            let key = format!("groups.{}", g.name);
+            self.validate_selection(&key, &g.select)?;
+            self.validate_supports_and_load(&key, g)?;
+        }
+        Ok(())
+    }
+
+    /// `groups.<name>.select`, its keys under `key` (`groups.<name>`).
+    fn validate_selection(&self, key: &str, select: &Selection) -> Result<(), SceneError> {
+        let dim = self.dim();
+        match select {
+            Selection::Edge { edge, rows } => {
+                if dim == 2 && matches!(edge, Edge::Front | Edge::Back) {
+                    return Err(invalid(
+                        format!("{key}.select.edge"),
+                        format!("{edge:?}").to_lowercase(),
+                        "bottom, top, left or right in 2D (front and back are the faces at the smallest and largest z of a 3D body)",
+                    ));
+                }
+                if *rows == 0 || *rows > 20 {
+                    return Err(invalid(
+                        format!("{key}.select.rows"),
+                        rows,
+                        "an integer from 1 to 20",
+                    ));
+                }
+            }
+            Selection::Strip {
+                edge,
+                width,
+                depth,
+                centre,
+            } => {
+                if matches!(edge, Edge::Front | Edge::Back) {
+                    return Err(invalid(
+                        format!("{key}.select.edge"),
+                        format!("{edge:?}").to_lowercase(),
+                        "bottom, top, left or right: a strip runs along the body's section (in 3D along z, the generatrix of a cylinder or a prism)",
+                    ));
+                }
+                if dim == 3 && !self.has_section_along_z() {
+                    return Err(invalid(
+                        format!("{key}.select"),
+                        select.scene_text(),
+                        format!(
+                            "a strip follows the section of a prism or of a cylinder along z, and this body (\"{}\") has none: select a face with by = \"edge\", or a region with by = \"box\"",
+                            self.body.name()
+                        ),
+                    ));
+                }
+                positive(&format!("{key}.select.width"), *width)?;
+                finite(&format!("{key}.select.centre"), *centre)?;
+                if let Some(dp) = depth {
+                    positive(&format!("{key}.select.depth"), *dp)?;
+                }
+            }
+            Selection::Box { min, max } => select_box(key, min, max, dim)?,
+            Selection::Nearest { point } => {
+                components(&format!("{key}.select.point"), point, dim)?;
+                for (c, v) in point.iter().enumerate() {
+                    finite(&format!("{key}.select.point[{c}]"), *v)?;
+                }
+            }
+            Selection::All => {}
+        }
+        Ok(())
+    }
+
+    /// `fix` and `load` of a group, its keys under `key`: axes the scene has, each fixed at
+    /// most once, and a load of a finite displacement, at most the body's size, on a free axis.
+    fn validate_supports_and_load(&self, key: &str, g: &GroupSpec) -> Result<(), SceneError> {
+        let dim = self.dim();
+        let mut fixed = HashSet::new();
+        let axes = g
+            .fix
+            .iter()
+            .map(|a| (a, "fix"))
+            .chain(g.load.as_ref().map(|l| (&l.component, "load.component")));
+        for (a, what) in axes {
+            if a.index() >= dim {
+                return Err(invalid(
+                    format!("{key}.{what}"),
+                    "\"z\"",
+                    "the axes \"x\" and \"y\" in 2D (\"z\" is for 3D scenes, lattice = \"fcc\")",
+                ));
+            }
+        }
+        for a in &g.fix {
+            if !fixed.insert(a.index()) {
+                return Err(invalid(
+                    format!("{key}.fix"),
+                    format!("{:?}", g.fix),
+                    "each axis at most once",
+                ));
+            }
+        }
+        if let Some(l) = &g.load {
+            finite(&format!("{key}.load.displacement"), l.delta())?;
+            // a displacement beyond the body's size is no loading of a specimen (and at
+            // 1e300 m the energies overflow)
+            if l.delta().abs() > self.body_size() {
+                return Err(invalid(
+                    format!("{key}.load.displacement"),
+                    l.delta(),
+                    format!(
+                        "at most the body's smallest dimension ({:.4e} m) in magnitude",
+                        self.body_size()
+                    ),
+                ));
+            }
+            if fixed.contains(&l.component.index()) {
+                return Err(invalid(
+                    format!("{key}.load.component"),
+                    format!("{:?}", l.component).to_lowercase(),
+                    "a component that is not also in fix",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A point or corner under `key` with one component per dimension of the scene.
+fn components(key: &str, v: &[f64], dim: usize) -> Result<(), SceneError> {
+    if v.len() != dim {
+        return Err(invalid(
+            key,
+            format!("{v:?}"),
+            format!("{dim} components (m), one per dimension of the scene"),
+        ));
+    }
+    Ok(())
+}
+
+/// `select = { by = "box" }`: two corners of the scene's dimension, `max` above `min`.
+fn select_box(key: &str, min: &[f64], max: &[f64], dim: usize) -> Result<(), SceneError> {
+    for (corner, v) in [("min", min), ("max", max)] {
+        components(&format!("{key}.select.{corner}"), v, dim)?;
+    }
+    for c in 0..dim {
+        finite(&format!("{key}.select.min[{c}]"), min[c])?;
+        finite(&format!("{key}.select.max[{c}]"), max[c])?;
+        if max[c] <= min[c] {
+            return Err(invalid(
+                format!("{key}.select.max[{c}]"),
+                max[c],
+                format!("must be greater than select.min[{c}] = {}", min[c]),
+            ));
+        }
+    }
+    Ok(())
+}
