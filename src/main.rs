@@ -3,7 +3,7 @@
 use anyhow::Context;
 use clap::{Parser, Subcommand};
 use sppm::fsio::{FolderBusy, IoFailure};
-use sppm::run::{estimated_memory, RunOptions};
+use sppm::run::RunOptions;
 use sppm::{say, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -126,7 +126,6 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         } => run_scene(&scene, out, &set, quiet, threads),
         Command::Check { scene, set } => {
             let sc = Scene::from_file(&scene, &set)?;
-            let mem = estimated_memory(&sc);
             // large bodies take minutes to set up: say what is going on (stderr)
             let started = std::time::Instant::now();
             let loud = sppm::run::estimated_particles(&sc) >= CHECK_PROGRESS_PARTICLES;
@@ -135,7 +134,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     eprintln!("[{:7.1} s] {what}…", started.elapsed().as_secs_f64());
                 }
             };
-            sppm::run::dispatch(&sc, Check { mem, stage: &stage })?;
+            sppm::run::check::check(&sc, &stage)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Bench(args) => bench(&args),
@@ -255,149 +254,4 @@ fn bench(args: &BenchArgs) -> anyhow::Result<ExitCode> {
     .context("benchmark failed")?;
     say!("{}", serde_json::to_string(&r)?);
     Ok(ExitCode::SUCCESS)
-}
-
-/// `sppm check` of a scene with its generator: the body, groups, T1, time step, memory and
-/// the run time from a few timed steps of the real kernel.
-struct Check<'a> {
-    mem: f64,
-    stage: &'a dyn Fn(&str),
-}
-
-impl sppm::run::TypedRun for Check<'_> {
-    type Output = anyhow::Result<()>;
-
-    fn run<G, const D: usize, const K: usize>(self, sc: &Scene, generator: G) -> Self::Output
-    where
-        G: sppm::run::Generator<D, K>,
-        sppm::model::dimension::Dim<D>:
-            sppm::model::dimension::Dimension<D> + sppm::run::recover::Recover<D>,
-    {
-        let p = sppm::run::prepare_with(sc, generator, self.stage)?;
-        check(sc, self.mem, self.stage, p)
-    }
-}
-
-/// `sppm check` of a prepared scene (2D, or 3D: FCC or random particles).
-fn check<const K: usize, const D: usize>(
-    sc: &Scene,
-    mem: f64,
-    stage: &dyn Fn(&str),
-    mut p: sppm::run::Prepared<K, D>,
-) -> anyhow::Result<()>
-where
-    sppm::model::dimension::Dim<D>: sppm::model::dimension::Dimension<D>,
-{
-    stage("timing a few steps of the kernel");
-    // calibrate the run time with a few steps of the real kernel (with damage and
-    // plasticity where the scene has them)
-    let mut sim = sppm::run::build_simulation(&mut p);
-    let calib = 20.min(p.steps.max(1));
-    let t = std::time::Instant::now();
-    for _ in 0..calib {
-        sim.advance(None);
-    }
-    let per_step = t.elapsed().as_secs_f64() / calib as f64;
-    say!("scene            {}", sc.name());
-    if D == 3 {
-        say!(
-            "lattice          {} (3D), rotation {:?}°",
-            if sc.discretisation.is_random() {
-                "random particles"
-            } else {
-                "fcc"
-            },
-            sc.discretisation.rotation_deg.angles()
-        );
-    }
-    say!("particles        {}", p.model.particles.len());
-    say!("bonds            {}", p.model.particles.bonds());
-    say!(
-        "groups           {}",
-        p.model
-            .groups
-            .iter()
-            .map(|g| format!("{} ({})", g.name, g.members.len()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    say!("fundamental T1   {:.6e} s", p.fundamental.period);
-    say!("stable dt        {:.6e} s", p.stable.dt_stable);
-    say!("time step dt     {:.6e} s", p.dt);
-    let threads = rayon::current_num_threads();
-    let solver = &sc.solver;
-    if solver.method == sppm::scene::SolverMethod::QuasiStatic && sc.concrete.is_some() {
-        say!(
-            "solver           quasi_static: {} increments along the ramp (smaller while damage grows), at most {} iterations each (tolerance {:e}); each iteration evaluates the forces, each change of state refactorises the sparse stiffness (docs/quasi_static.md)",
-            solver.increments, solver.max_iterations(), solver.tolerance
-        );
-        say!(
-            "memory (est.)    {:.1} MiB, and the sparse factor",
-            mem / 2f64.powi(20)
-        );
-        say!("run time (est.)  none: it depends on how the crack grows");
-    } else if solver.method.is_incremental() {
-        // the iterations per increment are known only once it has converged
-        let most = solver.increments * solver.max_iterations();
-        say!(
-            "solver           {}: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
-            solver.method.name(), solver.increments, solver.max_iterations(), solver.tolerance
-        );
-        say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-        say!(
-            "run time (est.)  at most {:.1} s on {threads} threads ({most} iterations); elastic increments converge in 1–10",
-            per_step * most as f64
-        );
-    } else {
-        say!("t_end            {:.6e} s", p.t_end);
-        say!("steps            {}", p.steps);
-        say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
-        say!(
-            "run time (est.)  {:.1} s on {threads} threads",
-            per_step * p.steps as f64
-        );
-    }
-    let sf = &p.model.surface;
-    say!(
-        "surface          {}: {} boundary particles, {} fitted; largest residual {:.4}; particles' volume {:+.2e} of the body's",
-        sf.method,
-        sf.boundary_particles,
-        sf.corrected,
-        sf.max_residual,
-        sf.particle_volume / sf.body_volume - 1.0
-    );
-    for d in &sc.derived {
-        say!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);
-    }
-    if let Some(r) = &p.model.random {
-        let g = &r.generation;
-        say!(
-            "random particles {} ({} on the boundary; the lattice's density: {})",
-            g.particles,
-            g.outline_particles,
-            g.target
-        );
-        say!(
-            "nearest distance min {:.3} / mean {:.3} / max {:.3} × spacing",
-            g.nearest_min,
-            g.nearest_mean,
-            g.nearest_max
-        );
-        say!("bonds a particle {:?} (histogram from 0)", g.bond_histogram);
-        say!(
-            "generation       {:.3} s placing, {:.3} s Voronoi cells, {:.3} s bonds",
-            g.seconds_placing,
-            g.seconds_voronoi,
-            g.seconds_bonding
-        );
-        let m = &r.moduli;
-        say!(
-            "moduli residual  mean {:.4} / p99 {:.4} / max {:.4}; {} particle(s) without a fit",
-            m.residual_mean,
-            m.residual_p99,
-            m.residual_max,
-            m.unfitted
-        );
-    }
-    Ok(())
 }

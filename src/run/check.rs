@@ -1,0 +1,163 @@
+//! `sppm check`: a scene's body, groups, T1, time step, memory and the run time from a few
+//! timed steps of the real kernel, printed for the user, without running it.
+
+use super::dispatch::{dispatch, estimated_memory, TypedRun};
+use super::execute::build_simulation;
+use super::generate::Generator;
+use super::prepare::{prepare_with, Prepared};
+use super::recover::Recover;
+use super::RunError;
+use crate::model::dimension::{Dim, Dimension};
+use crate::say;
+use crate::scene::{Scene, SolverMethod};
+
+/// Check `scene` and print what a run of it would be; `stage` is told what starts (large
+/// bodies take minutes to set up).
+pub fn check(scene: &Scene, stage: &dyn Fn(&str)) -> Result<(), RunError> {
+    let mem = estimated_memory(scene);
+    dispatch(scene, Check { mem, stage })
+}
+
+/// `sppm check` of a scene with its generator: the body, groups, T1, time step, memory and
+/// the run time from a few timed steps of the real kernel.
+struct Check<'a> {
+    mem: f64,
+    stage: &'a dyn Fn(&str),
+}
+
+impl TypedRun for Check<'_> {
+    type Output = Result<(), RunError>;
+
+    fn run<G, const D: usize, const K: usize>(self, sc: &Scene, generator: G) -> Self::Output
+    where
+        G: Generator<D, K>,
+        Dim<D>: Dimension<D> + Recover<D>,
+    {
+        let p = prepare_with(sc, generator, self.stage)?;
+        report(sc, self.mem, self.stage, p)
+    }
+}
+
+/// `sppm check` of a prepared scene (2D, or 3D: FCC or random particles).
+fn report<const K: usize, const D: usize>(
+    sc: &Scene,
+    mem: f64,
+    stage: &dyn Fn(&str),
+    mut p: Prepared<K, D>,
+) -> Result<(), RunError>
+where
+    Dim<D>: Dimension<D>,
+{
+    stage("timing a few steps of the kernel");
+    // calibrate the run time with a few steps of the real kernel (with damage and
+    // plasticity where the scene has them)
+    let mut sim = build_simulation(&mut p);
+    let calib = 20.min(p.steps.max(1));
+    let t = std::time::Instant::now();
+    for _ in 0..calib {
+        sim.advance(None);
+    }
+    let per_step = t.elapsed().as_secs_f64() / calib as f64;
+    say!("scene            {}", sc.name());
+    if D == 3 {
+        say!(
+            "lattice          {} (3D), rotation {:?}°",
+            if sc.discretisation.is_random() {
+                "random particles"
+            } else {
+                "fcc"
+            },
+            sc.discretisation.rotation_deg.angles()
+        );
+    }
+    say!("particles        {}", p.model.particles.len());
+    say!("bonds            {}", p.model.particles.bonds());
+    say!(
+        "groups           {}",
+        p.model
+            .groups
+            .iter()
+            .map(|g| format!("{} ({})", g.name, g.members.len()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    say!("fundamental T1   {:.6e} s", p.fundamental.period);
+    say!("stable dt        {:.6e} s", p.stable.dt_stable);
+    say!("time step dt     {:.6e} s", p.dt);
+    let threads = rayon::current_num_threads();
+    let solver = &sc.solver;
+    if solver.method == SolverMethod::QuasiStatic && sc.concrete.is_some() {
+        say!(
+            "solver           quasi_static: {} increments along the ramp (smaller while damage grows), at most {} iterations each (tolerance {:e}); each iteration evaluates the forces, each change of state refactorises the sparse stiffness (docs/quasi_static.md)",
+            solver.increments, solver.max_iterations(), solver.tolerance
+        );
+        say!(
+            "memory (est.)    {:.1} MiB, and the sparse factor",
+            mem / 2f64.powi(20)
+        );
+        say!("run time (est.)  none: it depends on how the crack grows");
+    } else if solver.method.is_incremental() {
+        // the iterations per increment are known only once it has converged
+        let most = solver.increments * solver.max_iterations();
+        say!(
+            "solver           {}: {} increments of at most {} iterations (tolerance {:e}); its step is solver.safety × the undamped limit, not the dt above",
+            solver.method.name(), solver.increments, solver.max_iterations(), solver.tolerance
+        );
+        say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+        say!(
+            "run time (est.)  at most {:.1} s on {threads} threads ({most} iterations); elastic increments converge in 1–10",
+            per_step * most as f64
+        );
+    } else {
+        say!("t_end            {:.6e} s", p.t_end);
+        say!("steps            {}", p.steps);
+        say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+        say!(
+            "run time (est.)  {:.1} s on {threads} threads",
+            per_step * p.steps as f64
+        );
+    }
+    let sf = &p.model.surface;
+    say!(
+        "surface          {}: {} boundary particles, {} fitted; largest residual {:.4}; particles' volume {:+.2e} of the body's",
+        sf.method,
+        sf.boundary_particles,
+        sf.corrected,
+        sf.max_residual,
+        sf.particle_volume / sf.body_volume - 1.0
+    );
+    for d in &sc.derived {
+        say!("{:<16} {:<12.6e} {}", d.key, d.value, d.source);
+    }
+    if let Some(r) = &p.model.random {
+        let g = &r.generation;
+        say!(
+            "random particles {} ({} on the boundary; the lattice's density: {})",
+            g.particles,
+            g.outline_particles,
+            g.target
+        );
+        say!(
+            "nearest distance min {:.3} / mean {:.3} / max {:.3} × spacing",
+            g.nearest_min,
+            g.nearest_mean,
+            g.nearest_max
+        );
+        say!("bonds a particle {:?} (histogram from 0)", g.bond_histogram);
+        say!(
+            "generation       {:.3} s placing, {:.3} s Voronoi cells, {:.3} s bonds",
+            g.seconds_placing,
+            g.seconds_voronoi,
+            g.seconds_bonding
+        );
+        let m = &r.moduli;
+        say!(
+            "moduli residual  mean {:.4} / p99 {:.4} / max {:.4}; {} particle(s) without a fit",
+            m.residual_mean,
+            m.residual_p99,
+            m.residual_max,
+            m.unfitted
+        );
+    }
+    Ok(())
+}
