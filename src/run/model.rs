@@ -78,6 +78,38 @@ pub struct Model<const K: usize = 6, const D: usize = 2> {
     pub random: Option<RandomBody>,
 }
 
+/// A body's groups, which components its supports hold, and its prescribed displacements
+/// ([`supports`]).
+pub(crate) type Supports<const D: usize> = (Vec<groups::Group>, Vec<[bool; D]>, Vec<Prescribed>);
+
+impl<const K: usize, const D: usize> Model<K, D> {
+    /// The model of a body whose volumes and micro-moduli are set: its mechanics at the
+    /// scene's density.
+    pub(crate) fn new(
+        scene: &Scene,
+        particles: Particles<D, K>,
+        (groups, constrained, prescribed): Supports<D>,
+        bulk: MicroModuli,
+        surface: SurfaceCorrection,
+        fields: Vec<SampledField>,
+        random: Option<RandomBody>,
+    ) -> Self {
+        let mech = Mechanics::new(&particles, &vec![scene.material.rho; particles.len()]);
+        Model {
+            scene: scene.clone(),
+            particles,
+            groups,
+            prescribed,
+            constrained,
+            mech,
+            bulk,
+            surface,
+            fields,
+            random,
+        }
+    }
+}
+
 /// Particles the body will hold (area / cell area; in 3D volume / cell volume), known
 /// before anything is allocated.
 pub fn estimated_particles(scene: &Scene) -> f64 {
@@ -140,13 +172,12 @@ pub(crate) fn nu_outside_calibration(nu: f64, allowed: String) -> RunError {
 /// The scene's groups on a body, its supports (`constrained`) and its prescribed
 /// displacements; `select` picks a selection's members, `extent` describes the body for the
 /// message of a selection that picks nothing.
-#[allow(clippy::type_complexity)]
 pub(crate) fn supports<const D: usize, const K: usize>(
     scene: &Scene,
     particles: &Particles<D, K>,
     select: &dyn Fn(&crate::scene::Selection) -> Vec<u32>,
     extent: &str,
-) -> Result<(Vec<groups::Group>, Vec<[bool; D]>, Vec<Prescribed>), RunError> {
+) -> Result<Supports<D>, RunError> {
     let n = particles.len();
     let mut groups = Vec::new();
     let mut constrained = vec![[false; D]; n];

@@ -8,7 +8,6 @@ use crate::model::micro_modulus::{self, MicroModuli};
 use crate::run::model::{estimated_particles, supports, Model, RandomBody, SurfaceCorrection};
 use crate::run::RunError;
 use crate::scene::{Scene, Surface};
-use crate::solver::mechanics::Mechanics;
 use nalgebra::{Matrix3, Vector2};
 
 /// The scene's 2D shape, having told `stage` that the body is being filled.
@@ -119,20 +118,15 @@ pub(super) fn assemble_plane<const K: usize>(
     surface.particle_volume = particles.volume.iter().sum();
     particles.a = a;
     particles.b = b;
-    let rho = vec![m.rho; n];
-    let mech = Mechanics::new(&particles, &rho);
-    Ok(Model {
-        scene: scene.clone(),
+    Ok(Model::new(
+        scene,
         particles,
-        groups,
-        prescribed,
-        constrained,
-        mech,
+        (groups, constrained, prescribed),
         bulk,
         surface,
         fields,
         random,
-    })
+    ))
 }
 
 /// The boundary treatment of a lattice body (`discretisation.surface`, docs/model.md §1, §3) into

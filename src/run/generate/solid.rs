@@ -39,26 +39,19 @@ pub(super) fn assemble_solid<const K: usize>(
         "x ∈ [{:.6}, {:.6}] m, y ∈ [{:.6}, {:.6}] m, z ∈ [{:.6}, {:.6}] m",
         lo.x, hi.x, lo.y, hi.y, lo.z, hi.z
     );
-    let (groups, constrained, prescribed) = supports(
+    let supported = supports(
         scene,
         &particles,
         &|sel| groups::select_3d(sel, &particles, &solid, section.as_ref()),
         &extent,
     )?;
-    let mech = crate::solver::mechanics::Mechanics::new(
-        &particles,
-        &vec![scene.material.rho; particles.len()],
-    );
-    Ok(Model {
-        scene: scene.clone(),
+    Ok(Model::new(
+        scene,
         particles,
-        groups,
-        prescribed,
-        constrained,
-        mech,
+        supported,
         bulk,
         surface,
-        fields: Vec::new(),
+        Vec::new(),
         random,
-    })
+    ))
 }
