@@ -754,6 +754,30 @@ safety = 0.4897296086666986
     assert_eq!(run_quiet(&scene).summary.status, "completed");
 }
 
+/// A mutated dog-bone with material.rho = 3.4e199 kg/m³ overflowed its energies to NaN at
+/// step 1 and was reported unstable. A density above any material's is refused by name; a
+/// real one is accepted.
+#[test]
+fn regression_an_impossible_density_is_refused() {
+    let text = small_plate(0.1, 0.2, "");
+    for (rho, ok) in [
+        ("2400.0", true),
+        ("22590.0", true),
+        ("1.0e5", true),
+        ("3.4e199", false),
+    ] {
+        let r = Scene::from_toml_str(&text, &[format!("material.rho={rho}")]);
+        match (r, ok) {
+            (Ok(_), true) => {}
+            (Err(e), false) => {
+                let msg = e.to_string();
+                assert!(msg.contains("material.rho") && msg.contains("1e5"), "{msg}");
+            }
+            (r, _) => panic!("rho {rho}: {:?}", r.map(|_| ()).map_err(|e| e.to_string())),
+        }
+    }
+}
+
 /// Bug 4 (no validation, src/scene/validate/groups.rs): a load displacement of 1e300 m overflowed
 /// the energies to NaN at step 1. A displacement beyond the body's smallest dimension is now
 /// refused.
