@@ -84,6 +84,15 @@ where
     say!("fundamental T1   {:.6e} s", p.fundamental.period);
     say!("stable dt        {:.6e} s", p.stable.dt_stable);
     say!("time step dt     {:.6e} s", p.dt);
+    if let Some(m) = &p.mass_scaling {
+        say!(
+            "mass scaling     {} particles raised to {} × the median particle's step: {:.3}% of the mass added, the largest factor {:.2}",
+            m.particles,
+            m.fraction_of_median_step,
+            100.0 * m.added_mass_fraction,
+            m.largest_factor
+        );
+    }
     let threads = rayon::current_num_threads();
     let solver = &sc.solver;
     if solver.method == SolverMethod::QuasiStatic && sc.concrete.is_some() {

@@ -14,9 +14,10 @@ use crate::model::force_state::{dilatation_term, force_state};
 use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
-use crate::scene::{Scene, SolverMethod};
+use crate::scene::{Pace, Scene, SolverMethod};
 use crate::solver::inelastic::DamageKernel;
 use crate::solver::mechanics::{weighted, Mechanics};
+use crate::solver::pace::{Observed, PaceSettings, Pacer, PACE_KINETIC, PACE_TAIL};
 use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
 use nalgebra::{SMatrix, SVector};
 use std::time::Instant;
@@ -318,7 +319,9 @@ fn run_prepared<const K: usize, const D: usize>(
 }
 
 /// The explicit run to t_end with probe records (and the wall time at each), stopping at an
-/// instability, or after the peak with `loading.stop_after_peak` (then `true`).
+/// instability, or after the peak with `loading.stop_after_peak` (then `true`). With an
+/// adaptive pace (`loading.pace`) the records are spread over the load time τ and the run
+/// ends when τ reaches t_end.
 fn run_explicit<const K: usize, const D: usize>(
     sim: &mut Simulation<D, K>,
     p: &Prepared<K, D>,
@@ -326,30 +329,45 @@ fn run_explicit<const K: usize, const D: usize>(
     opts: &RunOptions,
     start: Instant,
 ) -> (Vec<Record>, Vec<f64>, Option<crate::solver::Unstable>, bool) {
-    let mut stop = PeakStop::new(p.model.scene.loading.stop_after_peak, probe);
+    let scene = &p.model.scene;
+    let mut stop = PeakStop::new(scene.loading.stop_after_peak, probe);
     let mut stopped = false;
-    let every = (p.steps / (p.model.scene.output.records - 1)).max(1);
-    let bar = if opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7 {
-        let b = indicatif::ProgressBar::new(p.steps as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} {wide_bar} {pos}/{len} steps  {elapsed_precise} ETA {eta}",
-            )
-            .unwrap(),
-        );
-        Some(b)
-    } else {
-        None
-    };
-    let mut records = Vec::with_capacity(p.model.scene.output.records + 1);
-    let mut wall_s = Vec::with_capacity(p.model.scene.output.records + 1);
+    let wanted = scene.output.records;
+    let every = (p.steps / (wanted - 1)).max(1);
+    let mut pacer = pacer(p, probe);
+    // adaptive pace: a record every `every` steps' worth of load time, at the fixed ramp's
+    // steps while the pace is 1
+    let gap = every as f64 * sim.integration.dt;
+    let mut next_record = 0.0;
+    let bar = progress_bar(p, opts);
+    let mut records = Vec::with_capacity(wanted + 1);
+    let mut wall_s = Vec::with_capacity(wanted + 1);
     let mut failure = None;
+    let dt = sim.integration.dt;
     for n in 0..p.steps {
-        let want = n % every == 0 || n + 1 == p.steps;
+        let (want, last) = match &mut pacer {
+            None => (n % every == 0 || n + 1 == p.steps, n + 1 == p.steps),
+            Some(pc) => {
+                let f = pc.next(dt);
+                sim.set_pace(f);
+                let tau = sim.load_time();
+                let last = tau + f * dt >= p.t_end || n + 1 == p.steps;
+                (tau + 0.5 * dt >= next_record || last, last)
+            }
+        };
         let rec = sim.advance(if want { Some(probe) } else { None });
         if let Some(r) = rec {
             records.push(r);
             wall_s.push(start.elapsed().as_secs_f64());
+            while next_record <= sim.load_time() - 0.5 * dt {
+                next_record += gap;
+            }
+            if let Some(pc) = &mut pacer {
+                pc.observe(Observed {
+                    record: &r,
+                    failed: sim.has_failed_particle(),
+                });
+            }
         }
         if want || n % 64 == 0 {
             let u = rec.map(|r| r.internal_j);
@@ -367,9 +385,47 @@ fn run_explicit<const K: usize, const D: usize>(
                 b.set_position(n as u64);
             }
         }
+        if last {
+            break;
+        }
     }
     if let Some(b) = bar {
         b.finish_and_clear();
     }
     (records, wall_s, failure, stopped)
+}
+
+/// The controller of an adaptive pace (`loading.pace = "adaptive"`), `None` for the fixed
+/// ramp (docs/model.md §10).
+fn pacer<const K: usize, const D: usize>(p: &Prepared<K, D>, probe: &Probe) -> Option<Pacer> {
+    let l = &p.model.scene.loading;
+    (p.model.scene.pace() == Some(Pace::Adaptive)).then(|| {
+        Pacer::new(
+            PaceSettings {
+                max: l.max_pace,
+                tail: PACE_TAIL,
+                kinetic: PACE_KINETIC,
+                period: p.fundamental.period,
+            },
+            if probe.amplitude < 0.0 { -1.0 } else { 1.0 },
+        )
+    })
+}
+
+/// The progress bar of a long run (more than 2e7 particle-steps), `None` otherwise.
+fn progress_bar<const K: usize, const D: usize>(
+    p: &Prepared<K, D>,
+    opts: &RunOptions,
+) -> Option<indicatif::ProgressBar> {
+    if !(opts.progress && (p.steps as f64 * p.model.particles.len() as f64) > 2e7) {
+        return None;
+    }
+    let b = indicatif::ProgressBar::new(p.steps as u64);
+    b.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{spinner} {wide_bar} {pos}/{len} steps  {elapsed_precise} ETA {eta}",
+        )
+        .unwrap(),
+    );
+    Some(b)
 }

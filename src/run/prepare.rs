@@ -6,8 +6,9 @@ use super::generate::Generator;
 use super::model::{check_size, Model};
 use super::RunError;
 use crate::material;
-use crate::scene::Scene;
-use crate::solver::time_step::{stable_step, StableStep};
+use crate::scene::{BondScheme, Scene};
+use crate::solver::mass_scaling::{scale_masses, MassScaling, MAX_ADDED_MASS};
+use crate::solver::time_step::{split_bond_dampers, stable_step, StableStep};
 use crate::solver::{modal, Probe};
 
 /// A discretised, assembled specimen ready to run: the model plus its dynamics.
@@ -15,6 +16,8 @@ pub struct Prepared<const K: usize = 6, const D: usize = 2> {
     pub model: Model<K, D>,
     pub fundamental: modal::Fundamental,
     pub stable: StableStep,
+    /// What selective mass scaling added (`solver.mass_scaling`), `None` without it.
+    pub mass_scaling: Option<MassScaling>,
     pub dt: f64,
     pub t_end: f64,
     pub steps: usize,
@@ -152,8 +155,17 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
         mech.c_in[i] = 2.0 * mech.mass[i] * scene.damping.internal * omega_i;
         mech.c_ex[i] = 2.0 * mech.mass[i] * scene.damping.external * omega_struct;
     }
+    let share = match scene.damping.bond_scheme_in(scene.dim()) {
+        BondScheme::Explicit => 0.0,
+        BondScheme::SemiImplicit => split_bond_dampers(&mut model.mech, &model.particles.x0),
+    };
+    let mass_scaling = match scene.solver.mass_scaling {
+        Some(q) => Some(scaled(&mut model.mech, &model.particles.x0, q)?),
+        None => None,
+    };
     stage("stable time step (largest frequency, Lanczos)");
-    let stable = stable_step(&model.mech, &model.particles.x0);
+    let mut stable = stable_step(&model.mech, &model.particles.x0);
+    stable.implicit_share = share;
     let dt = match scene.solver.dt {
         Some(dt) if dt > stable.dt_stable => {
             return Err(RunError::Scene(crate::scene::SceneError::Invalid {
@@ -214,9 +226,34 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
         model,
         fundamental,
         stable,
+        mass_scaling,
         dt,
         t_end,
         steps,
         probe,
     })
+}
+
+/// Selective mass scaling to `q` × the median particle's step (docs/model.md §5, (S.18)),
+/// refused where it adds more than [`MAX_ADDED_MASS`] of the specimen's mass.
+fn scaled<const K: usize, const D: usize>(
+    mech: &mut crate::solver::mechanics::Mechanics<D, K>,
+    x0: &[nalgebra::SVector<f64, D>],
+    q: f64,
+) -> Result<MassScaling, RunError> {
+    let r = scale_masses(mech, x0, q);
+    if r.added_mass_fraction > MAX_ADDED_MASS {
+        return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+            key: "solver.mass_scaling".into(),
+            value: format!("{q}"),
+            allowed: format!(
+                "a fraction that adds at most {:.0}% of the specimen's mass; {q} adds {:.1}% ({} particles raised, the largest {:.1}×): lower solver.mass_scaling",
+                100.0 * MAX_ADDED_MASS,
+                100.0 * r.added_mass_fraction,
+                r.particles,
+                r.largest_factor
+            ),
+        }));
+    }
+    Ok(r)
 }

@@ -108,6 +108,18 @@ pub struct Summary {
     pub offset_m: Vec<f64>,
     pub omega_max_rad_s: f64,
     pub omega_max_bound_rad_s: f64,
+    /// How the bond dampers were integrated (docs/model.md §5): `explicit` or
+    /// `semi_implicit`.
+    pub bond_damper_scheme: crate::scene::BondScheme,
+    /// The bond dampers' damping ratio ζ at ω_max.
+    pub bond_damping_ratio_at_omega_max: f64,
+    /// σ of (S.17): the share of the bond dampers taken implicitly (0: explicit).
+    pub bond_damper_implicit_share: f64,
+    /// How the explicit run read the ramp (`loading.pace`): `fixed` or `adaptive`; `null`
+    /// for the relaxation and quasi-static solvers.
+    pub pace: Option<crate::scene::Pace>,
+    /// What selective mass scaling added (docs/model.md §5, (S.18)); `null` without it.
+    pub mass_scaling: Option<crate::solver::mass_scaling::MassScaling>,
     /// The scene's seed (`Scene::effective_seed`), `None` when it makes no random choice.
     pub seed: Option<u64>,
     /// Each random field: its parameters, seed and the statistics of the particles' values.
@@ -372,6 +384,11 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         offset_m: d.offset.clone(),
         omega_max_rad_s: p.stable.omega_max,
         omega_max_bound_rad_s: p.stable.omega_max_bound,
+        bond_damper_scheme: p.model.scene.damping.bond_scheme_in(p.model.scene.dim()),
+        bond_damping_ratio_at_omega_max: p.stable.zeta,
+        bond_damper_implicit_share: p.stable.implicit_share,
+        mass_scaling: p.mass_scaling,
+        pace: p.model.scene.pace(),
         seed: p.model.scene.effective_seed(),
         random_fields: p.model.fields.iter().map(|f| f.report.clone()).collect(),
         sppm_version: env!("CARGO_PKG_VERSION").to_string(),

@@ -44,6 +44,50 @@ pub struct LoadingSpec {
     /// the peak and a particle has failed (w_t or w_c ≥ 0.99); scenes with `[concrete]`.
     #[serde(default)]
     pub stop_after_peak: Option<f64>,
+    /// How fast the explicit run reads the ramp: `fixed` (in time) or `adaptive`
+    /// (docs/model.md §10, "Adaptive pace"); left out, [`LoadingSpec::pace_of`] decides.
+    #[serde(default)]
+    pub pace: Option<Pace>,
+    /// The largest pace factor of an adaptive pace.
+    #[serde(default = "default_max_pace")]
+    pub max_pace: f64,
+}
+
+/// How fast an explicit run reads the ramp (docs/model.md §10).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Pace {
+    /// The ramp in time, t_ramp = ramp_fraction × t_end.
+    Fixed,
+    /// The ramp at a load time that runs up to max_pace times faster on the post-peak tail.
+    Adaptive,
+}
+
+impl Pace {
+    /// The key's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pace::Fixed => "fixed",
+            Pace::Adaptive => "adaptive",
+        }
+    }
+}
+
+fn default_max_pace() -> f64 {
+    8.0
+}
+
+impl LoadingSpec {
+    /// The pace of a `dim`-dimensional explicit run, `fracture` with `[concrete]`: the key's
+    /// value; left out, adaptive for fracture in 3D (benchmarks/RESULTS.md, "Adaptive pace")
+    /// and fixed otherwise (2D: the validated records; an elastic run has no tail).
+    pub fn pace_of(&self, dim: usize, fracture: bool) -> Pace {
+        self.pace.unwrap_or(if dim == 3 && fracture {
+            Pace::Adaptive
+        } else {
+            Pace::Fixed
+        })
+    }
 }
 
 impl Default for LoadingSpec {
@@ -54,6 +98,8 @@ impl Default for LoadingSpec {
             end_periods: None,
             end_s: None,
             stop_after_peak: None,
+            pace: None,
+            max_pace: default_max_pace(),
         }
     }
 }
@@ -83,6 +129,44 @@ pub struct DampingSpec {
     /// ξ_ex, particle-velocity dampers on the fundamental mode (3.56).
     #[serde(default)]
     pub external: f64,
+    /// How the explicit step integrates the bond dampers (docs/model.md §5); left out,
+    /// [`DampingSpec::bond_scheme_in`] decides by the dimension.
+    #[serde(default)]
+    pub bond_scheme: Option<BondScheme>,
+}
+
+/// How the explicit step integrates the bond dampers (docs/model.md §5).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum BondScheme {
+    /// Wholly at v^{n−½} (3.55): the dampers lower the stable step,
+    /// Δt ≤ (2/ω_max)(√(1+ζ²) − ζ).
+    Explicit,
+    /// A diagonal share implicitly (S.17): the stable step is the undamped one, 2/ω_max.
+    SemiImplicit,
+}
+
+impl BondScheme {
+    /// The key's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            BondScheme::Explicit => "explicit",
+            BondScheme::SemiImplicit => "semi_implicit",
+        }
+    }
+}
+
+impl DampingSpec {
+    /// The scheme of a `dim`-dimensional run: the key's value; left out, semi-implicit in 3D
+    /// (where the explicit dampers cut the step 4–8×: benchmarks/RESULTS.md, "Bond dampers
+    /// that keep the undamped step") and explicit in 2D (the validated records).
+    pub fn bond_scheme_in(&self, dim: usize) -> BondScheme {
+        self.bond_scheme.unwrap_or(if dim == 3 {
+            BondScheme::SemiImplicit
+        } else {
+            BondScheme::Explicit
+        })
+    }
 }
 
 impl Default for DampingSpec {
@@ -90,6 +174,7 @@ impl Default for DampingSpec {
         DampingSpec {
             internal: 0.0,
             external: 0.0,
+            bond_scheme: None,
         }
     }
 }

@@ -15,7 +15,7 @@ mod validate;
 
 pub use body::{BodySpec, CutoutSpec};
 pub use discretisation::{Discretisation, DiscretisationSpec, Lattice, Rotation, Surface};
-pub use loading::{DampingSpec, LoadSpec, LoadingSpec, Ramp};
+pub use loading::{BondScheme, DampingSpec, LoadSpec, LoadingSpec, Pace, Ramp};
 pub use overrides::apply_overrides;
 pub use solver_settings::{ControlSpec, ForceLag, SolverMethod, SolverSpec};
 pub use validate::SceneError;
@@ -499,6 +499,13 @@ impl Scene {
     /// (box, cylinder, prism), 2 otherwise.
     pub fn dim(&self) -> usize {
         self.discretisation().dim()
+    }
+
+    /// How an explicit run of this scene reads its ramp (`loading.pace`, docs/model.md §10);
+    /// `None` for the relaxation and quasi-static solvers, whose increments set the pace.
+    pub fn pace(&self) -> Option<Pace> {
+        (!self.solver.method.is_incremental())
+            .then(|| self.loading.pace_of(self.dim(), self.concrete.is_some()))
     }
 
     /// Parse TOML text, apply `key=value` overrides, and validate.

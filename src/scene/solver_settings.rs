@@ -34,6 +34,10 @@ pub struct SolverSpec {
     pub dt: Option<f64>,
     #[serde(default = "default_lag")]
     pub force_lag: ForceLag,
+    /// Selective mass scaling (docs/model.md §5, (S.18)): every particle's own stable step
+    /// raised to this fraction of the median particle's by added mass; left out, none.
+    #[serde(default)]
+    pub mass_scaling: Option<f64>,
     /// Worker threads (default: all cores).
     #[serde(default)]
     pub threads: Option<usize>,
@@ -117,6 +121,7 @@ impl Default for SolverSpec {
             safety: default_safety(),
             dt: None,
             force_lag: default_lag(),
+            mass_scaling: None,
             threads: None,
             method: SolverMethod::default(),
             increments: default_increments(),

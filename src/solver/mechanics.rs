@@ -39,6 +39,9 @@ pub struct Mechanics<const D: usize, const K: usize> {
     pub c_in: Aligned<f64>,
     /// Particle damper coefficient C_ex,i = 2·m_i·ξ_ex·ω_struct (3.56).
     pub c_ex: Aligned<f64>,
+    /// The share d_i of the bond dampers taken implicitly (N·s/m; docs/model.md §5, (S.17)):
+    /// all zero for bond dampers taken wholly at v^{n−½}.
+    pub c_implicit: Aligned<f64>,
     /// Per-slot weight L0,ik/ℓ_i of the dilatation θ_i = Σ_k w_ik·S_ik where the body asks
     /// for it (random particles, [`Particles::weighted_dilatation`]); `None`: θ_i = Σ_k S_ik.
     pub dilatation_weight: Option<Aligned<[f64; K]>>,
@@ -67,6 +70,7 @@ impl<const D: usize, const K: usize> Default for Mechanics<D, K> {
             inv_mass: Aligned::new(0),
             c_in: Aligned::new(0),
             c_ex: Aligned::new(0),
+            c_implicit: Aligned::new(0),
             dilatation_weight: None,
             slot_weight: None,
             slot_end: Aligned::new(0),
@@ -203,6 +207,7 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             mass,
             c_in: filled(0.0, n),
             c_ex: filled(0.0, n),
+            c_implicit: filled(0.0, n),
             dilatation_weight,
             slot_end: slot_end(&p.neighbours),
         }
@@ -275,6 +280,17 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
     /// S_ij = n_ij·(u_j − u_i)/L_ij and θ_i = Σ_m w_im·S_im (a + c in place of a in a
     /// second-neighbour slot, [`Self::bond_moduli`]).
     pub fn max_eigenvalue_bound(&self, x0: &[SVector<f64, D>]) -> f64 {
+        self.row_bounds(x0)
+            .iter()
+            .zip(self.inv_mass.iter())
+            .map(|(r, im)| r * im)
+            .fold(0.0, f64::max)
+    }
+
+    /// Each particle's block-row sum r_i of the linearised stiffness (N/m), blocks bounded by
+    /// their 2-norms: r_i/m_i bounds the squared frequency of the particle moving alone, and
+    /// the largest of them bounds ω_max² ([`Self::max_eigenvalue_bound`], which derives it).
+    pub fn row_bounds(&self, x0: &[SVector<f64, D>]) -> Vec<f64> {
         let n = self.len();
         // |Σ_m n_im / L_im| and Σ_m 1/L_im per particle
         let mut sum_n_over_l = vec![0.0; n];
@@ -294,8 +310,8 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             sum_n_over_l[i] = s.norm();
             sum_n[i] = sn.norm();
         }
-        let mut worst: f64 = 0.0;
-        for i in 0..n {
+        let mut rows = vec![0.0; n];
+        for (i, row) in rows.iter_mut().enumerate() {
             let mut r = 0.0;
             let bi = self.b[i].abs();
             for (k, j, il) in self.bonds(i) {
@@ -308,9 +324,9 @@ impl<const D: usize, const K: usize> Mechanics<D, K> {
             }
             // b_i θ_i term: ½ b_i θ_i Σ_j n_ij, blocks to every neighbour m and to u_i
             r += 0.5 * bi * sum_n[i] * (sum_inv_l[i] + sum_n_over_l[i]);
-            worst = worst.max(r * self.inv_mass[i]);
+            *row = r;
         }
-        worst
+        rows
     }
 
     /// Upper bound of the spectral radius of M⁻¹C_in (bond dampers, treated explicitly).

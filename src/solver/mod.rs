@@ -6,8 +6,10 @@ pub mod kernel;
 pub mod lanczos;
 pub mod linear;
 pub mod loading;
+pub mod mass_scaling;
 pub mod mechanics;
 pub mod modal;
+pub mod pace;
 pub mod relaxation;
 pub mod secant;
 pub mod time_step;
@@ -269,6 +271,21 @@ pub struct Simulation<const D: usize, const K: usize> {
     pub inelastic: Option<Box<dyn inelastic::Inelastic<D, K>>>,
     /// Load factor held instead of the time ramp (dynamic relaxation), see [`Self::hold_load`].
     held: Option<HeldLoad>,
+    /// The load clock of an adaptive pace (`pace`), `None` for the fixed ramp in time.
+    clock: Option<LoadClock>,
+}
+
+/// The load time τ of an adaptive pace: the ramp is read at τ = t + lead, and the lead grows
+/// by (factor − 1)·Δt a step (docs/model.md §10, "Adaptive pace"). While the factor is 1 the
+/// ramp is read at the fixed ramp's times, bit for bit.
+#[derive(Clone, Copy, Debug)]
+struct LoadClock {
+    /// The lead at the previous step.
+    before: f64,
+    /// The lead at this step.
+    now: f64,
+    /// dτ/dt of this step.
+    factor: f64,
 }
 
 /// A load factor held from a given step on (the factor `before` applies to earlier steps).
@@ -302,6 +319,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             bond_dampers,
             inelastic: None,
             held: None,
+            clock: None,
         };
         // The elastic energy at rest is not zero to round-off (positions far from the origin
         // or offset by many cells, rotated lattices): it is initial energy, part of E0.
@@ -390,6 +408,23 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         });
     }
 
+    /// Read the ramp at a load time that advances `factor` times as fast as time from this
+    /// step on (adaptive pace, [`pace`]).
+    pub fn set_pace(&mut self, factor: f64) {
+        let clock = self.clock.get_or_insert(LoadClock {
+            before: 0.0,
+            now: 0.0,
+            factor,
+        });
+        clock.factor = factor;
+    }
+
+    /// The load time τ: the time for the fixed ramp, time plus the load clock's lead for an
+    /// adaptive pace.
+    pub fn load_time(&self) -> f64 {
+        self.time() + self.clock.map_or(0.0, |c| c.now)
+    }
+
     /// Book work done on the specimen outside the kernel (the displacement predictor of
     /// dynamic relaxation moves free particles between steps).
     pub fn add_external_work(&mut self, work: f64) {
@@ -437,12 +472,30 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         let dt = self.integration.dt;
         let t = self.time();
         // The ramp at n−1, n and n+1, once for every prescribed component.
-        let r_prev = if self.step == 0 {
-            0.0
-        } else {
-            self.ramp_at(t - dt)
+        let (r_prev, r_now, r_next) = match self.clock {
+            None => {
+                let r_prev = if self.step == 0 {
+                    0.0
+                } else {
+                    self.ramp_at(t - dt)
+                };
+                (r_prev, self.ramp_at(t), self.ramp_at(t + dt))
+            }
+            Some(c) => {
+                let at = |tau| ramp_fraction(self.integration.ramp, tau, self.integration.t_ramp);
+                let r_prev = if self.step == 0 {
+                    0.0
+                } else {
+                    at(t - dt + c.before)
+                };
+                let lead = c.now + (c.factor - 1.0) * dt;
+                (r_prev, at(t + c.now), at(t + dt + lead))
+            }
         };
-        let (r_now, r_next) = (self.ramp_at(t), self.ramp_at(t + dt));
+        if let Some(c) = &mut self.clock {
+            c.before = c.now;
+            c.now += (c.factor - 1.0) * dt;
+        }
         // Supports and displacement loading; work of the reactions (central rule).
         let mut work = 0.0;
         let mut work_half = 0.0;
@@ -455,6 +508,12 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             if c_ex != 0.0 {
                 let vm = 0.5 * (self.state.v[i][c] + self.state.v_next[i][c]);
                 self.state.damping_work[i] -= dt * c_ex * vm * vm;
+            }
+            // ... nor the implicit share of the bond dampers (S.17)
+            let c_im = self.mech.c_implicit[i];
+            if c_im != 0.0 {
+                let (v0, v1) = (self.state.v[i][c], self.state.v_next[i][c]);
+                self.state.damping_work[i] -= dt * c_im * (v1 - v0) * 0.5 * (v0 + v1);
             }
             self.state.x_next[i][c] = self.x0[i][c] + u_next;
             self.state.v_next[i][c] = (self.state.x_next[i][c] - self.state.x[i][c]) / dt;

@@ -131,6 +131,7 @@ pub fn undamped<const D: usize, const K: usize>(
 ) -> StableStep {
     mech.c_in.iter_mut().for_each(|c| *c = 0.0);
     mech.c_ex.iter_mut().for_each(|c| *c = 0.0);
+    mech.c_implicit.iter_mut().for_each(|c| *c = 0.0);
     stable_step(mech, x0)
 }
 

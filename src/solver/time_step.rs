@@ -34,6 +34,8 @@ pub struct StableStep {
     pub omega_max_bound: f64,
     /// Damping ratio of the bond dampers at ω_max.
     pub zeta: f64,
+    /// σ of (S.17), the implicit share of the bond dampers; 0 when they are wholly explicit.
+    pub implicit_share: f64,
     /// Largest stable Δt (s).
     pub dt_stable: f64,
 }
@@ -74,11 +76,46 @@ pub fn stable_step<const D: usize, const K: usize>(
         0.0
     };
     let zeta = rate / (2.0 * omega_max);
-    let dt_stable = 2.0 / omega_max * ((1.0 + zeta * zeta).sqrt() - zeta);
+    // with an implicit share of the bond dampers (S.17) the limit is the undamped one
+    let dt_stable = if mech.c_implicit.iter().any(|&d| d != 0.0) {
+        2.0 / omega_max
+    } else {
+        2.0 / omega_max * ((1.0 + zeta * zeta).sqrt() - zeta)
+    };
     StableStep {
         omega_max,
         omega_max_bound: bound.sqrt(),
         zeta,
+        implicit_share: 0.0,
         dt_stable,
     }
+}
+
+/// Take a share of the bond dampers implicitly (docs/model.md §5, (S.17)): d_i = σ·Σ_j c_ij,
+/// c_ij = ½(C_in,i + C_in,j), with σ = ½·λ_max(D_Σ^{-1/2}·C·D_Σ^{-1/2})·(1 + margin), the
+/// smallest multiple of the damper sums D_Σ = diag(Σ_j c_ij) for which diag(d) ⪰ C/2
+/// (Lanczos; at most 1, since C ⪯ 2·D_Σ). Sets `mech.c_implicit` and returns σ (0 without
+/// bond dampers).
+pub fn split_bond_dampers<const D: usize, const K: usize>(
+    mech: &mut Mechanics<D, K>,
+    x0: &[SVector<f64, D>],
+) -> f64 {
+    let sums: Vec<f64> = (0..mech.len())
+        .map(|i| {
+            mech.bonds(i)
+                .map(|(_, j, _)| 0.5 * (mech.c_in[i] + mech.c_in[j]))
+                .sum()
+        })
+        .collect();
+    if !sums.iter().any(|&s| s > 0.0) {
+        return 0.0;
+    }
+    // a particle without dampers is not coupled by C: any positive weight will do
+    let weight: Vec<f64> = sums.iter().map(|&s| s.max(f64::MIN_POSITIVE)).collect();
+    let lambda = largest::<D>(&weight, |v, out| apply_bond_dampers(mech, x0, v, out));
+    let sigma = (0.5 * lambda * (1.0 + LANCZOS_MARGIN)).min(1.0);
+    for (d, s) in mech.c_implicit.iter_mut().zip(&sums) {
+        *d = sigma * s;
+    }
+    sigma
 }

@@ -10,6 +10,7 @@ mod concrete_3d;
 mod concrete_input;
 mod cutouts;
 mod damage_law;
+mod dampers_and_pace;
 mod docs;
 mod elastic_plate;
 mod fcc;

@@ -17,6 +17,22 @@ impl Scene {
         if let Some(dt) = s.dt {
             positive("solver.dt", dt)?;
         }
+        if let Some(q) = s.mass_scaling {
+            if !(q > 0.0 && q <= 1.0) {
+                return Err(invalid(
+                    "solver.mass_scaling",
+                    q,
+                    "must satisfy 0 < mass_scaling <= 1 (the fraction of the median particle's stable step that every particle's step is raised to by added mass)",
+                ));
+            }
+            if s.method.is_incremental() {
+                return Err(invalid(
+                    "solver.mass_scaling",
+                    q,
+                    format!("only with solver.method = \"explicit\" (here \"{}\", whose step is its own)", s.method.name()),
+                ));
+            }
+        }
         if let Some(t) = s.threads {
             if t == 0 || t > 1024 {
                 return Err(invalid("solver.threads", t, "an integer from 1 to 1024"));

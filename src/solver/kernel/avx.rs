@@ -367,8 +367,11 @@ pub(crate) unsafe fn update_block<
     let im = _mm256_loadu_pd(m.inv_mass.as_ptr().add(i0));
     // h = 0.5 * dt * c_ex * inv_mass
     let h = _mm256_mul_pd(_mm256_mul_pd(half_dt, cex), im);
-    let one_m_h = _mm256_sub_pd(one, h);
-    let one_p_h = _mm256_add_pd(one, h);
+    // g = 1 + dt * c_implicit * inv_mass (S.17)
+    let cim = _mm256_loadu_pd(m.c_implicit.as_ptr().add(i0));
+    let g = _mm256_add_pd(one, _mm256_mul_pd(_mm256_mul_pd(dtv, cim), im));
+    let one_m_h = _mm256_sub_pd(g, h);
+    let one_p_h = _mm256_add_pd(g, h);
     let dt_im = _mm256_mul_pd(dtv, im);
     let vi = load_own(v, i0);
     let xi = load_own(x, i0);
@@ -386,18 +389,28 @@ pub(crate) unsafe fn update_block<
     }
     store_own2(vn, o0, &vnew);
     store_own2(xn, o0, &xnew);
-    // dw += dt * (bond_power + c_ex * |½(v_i + v_new)|²) where DAMP or h ≠ 0
+    // dw += dt * (bond_power + c_ex * |½(v_i + v_new)|² + implicit) where DAMP or h ≠ 0,
+    // and c_implicit * (v_new − v_i)·½(v_i + v_new)
     let mut vm2 = zero;
+    let mut dvm = zero;
     for c in 0..D {
         let vm = _mm256_mul_pd(_mm256_add_pd(vi[c], vnew[c]), half);
         let sq = _mm256_mul_pd(vm, vm);
+        let dv = _mm256_mul_pd(_mm256_sub_pd(vnew[c], vi[c]), vm);
         vm2 = if c == 0 { sq } else { _mm256_add_pd(vm2, sq) };
+        dvm = if c == 0 { dv } else { _mm256_add_pd(dvm, dv) };
     }
     let pw = dw.as_mut_ptr().add(o0);
     let old = _mm256_loadu_pd(pw);
     let new = _mm256_add_pd(
         old,
-        _mm256_mul_pd(dtv, _mm256_add_pd(power, _mm256_mul_pd(cex, vm2))),
+        _mm256_mul_pd(
+            dtv,
+            _mm256_add_pd(
+                _mm256_add_pd(power, _mm256_mul_pd(cex, vm2)),
+                _mm256_mul_pd(cim, dvm),
+            ),
+        ),
     );
     let new = if DAMP {
         new

@@ -312,7 +312,8 @@ fn update_one<const D: usize, const K: usize, const LAG: bool, const DAMP: bool>
 }
 
 /// Central differences (3.58) for particle i at x_i, v_i^{n−½} driven by `drive`, with the
-/// particle damper (3.56) taken semi-implicitly; adds the work of its dampers (the bond
+/// particle damper (3.56) taken semi-implicitly and the implicit share of the bond dampers
+/// (S.17); adds the work of its dampers (the bond
 /// dampers' `bond_power` and the particle damper's) over the step to `dw`. Shared by the
 /// elastic and the concrete kernels.
 #[inline(always)]
@@ -330,12 +331,15 @@ pub(crate) fn central_difference<const D: usize, const K: usize, const DAMP: boo
     dw: &mut f64,
 ) {
     let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
-    let vnew = (vi * (1.0 - h) + drive * (dt * m.inv_mass[i])) / (1.0 + h);
+    // (S.17): the implicit share d_i of the bond dampers, g = Δt·d_i/m_i (0: exactly (3.58))
+    let g = 1.0 + dt * m.c_implicit[i] * m.inv_mass[i];
+    let vnew = (vi * (g - h) + drive * (dt * m.inv_mass[i])) / (g + h);
     *vn = vnew;
     *xn = xi + vnew * dt;
     if DAMP || h != 0.0 {
         let vm = (vi + vnew) * 0.5;
-        *dw += dt * (bond_power + m.c_ex[i] * vm.norm_squared());
+        let implicit = m.c_implicit[i] * (vnew - vi).dot(&vm);
+        *dw += dt * (bond_power + m.c_ex[i] * vm.norm_squared() + implicit);
     }
 }
 

@@ -32,6 +32,10 @@ fn model<const D: usize, const K: usize>(n: usize) -> (Mechanics<D, K>, State<D>
     for c in c_ex.iter_mut().step_by(3) {
         *c = 0.0;
     }
+    // some with an implicit share of the bond dampers (g ≠ 0)
+    let c_implicit = (0..n)
+        .map(|i| if i % 2 == 0 { 0.0 } else { 5.0 * r.next() })
+        .collect_aligned();
     let slot_end = crate::solver::mechanics::slot_end(&neighbours);
     let mech = Mechanics {
         neighbours: copied(&neighbours),
@@ -44,6 +48,7 @@ fn model<const D: usize, const K: usize>(n: usize) -> (Mechanics<D, K>, State<D>
         mass,
         c_in,
         c_ex,
+        c_implicit,
         dilatation_weight: None,
         slot_weight: None,
         slot_end,
