@@ -177,6 +177,9 @@ fn run_scene(
             s.displacement_at_peak_m,
             s.max_kinetic_to_internal_energy
         );
+        for w in &s.warnings {
+            eprintln!("warning: {w}");
+        }
         for f in &files {
             say!("wrote {}", f.display());
         }

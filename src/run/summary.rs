@@ -120,12 +120,20 @@ pub struct Summary {
     pub pace: Option<crate::scene::Pace>,
     /// What selective mass scaling added (docs/model.md §5, (S.18)); `null` without it.
     pub mass_scaling: Option<crate::solver::mass_scaling::MassScaling>,
+    /// What the run did that may have changed its result, e.g. added mass with a kinetic
+    /// energy above the quasi-static limit; empty when nothing did.
+    pub warnings: Vec<String>,
     /// The scene's seed (`Scene::effective_seed`), `None` when it makes no random choice.
     pub seed: Option<u64>,
     /// Each random field: its parameters, seed and the statistics of the particles' values.
     pub random_fields: Vec<FieldReport>,
     pub sppm_version: String,
 }
+
+/// The kinetic-to-elastic energy ratio around the peak below which a run counts as
+/// quasi-static where the result might otherwise depend on inertia the specimen does not
+/// have (added mass).
+pub const QUASI_STATIC_LIMIT: f64 = 0.01;
 
 /// What a random body reports in summary.json.
 #[derive(Clone, Debug, Serialize)]
@@ -388,6 +396,17 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         bond_damping_ratio_at_omega_max: p.stable.zeta,
         bond_damper_implicit_share: p.stable.implicit_share,
         mass_scaling: p.mass_scaling,
+        warnings: p
+            .mass_scaling
+            .filter(|_| ratio > QUASI_STATIC_LIMIT)
+            .map(|m| {
+                format!(
+                    "solver.mass_scaling added {:.2}% of the mass and the kinetic energy reached {ratio:.3e} × the elastic energy around the peak, above the quasi-static {QUASI_STATIC_LIMIT}: the added mass may have changed the result; lower solver.mass_scaling or leave it out",
+                    100.0 * m.added_mass_fraction
+                )
+            })
+            .into_iter()
+            .collect(),
         pace: p.model.scene.pace(),
         seed: p.model.scene.effective_seed(),
         random_fields: p.model.fields.iter().map(|f| f.report.clone()).collect(),

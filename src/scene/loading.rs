@@ -74,7 +74,7 @@ impl Pace {
 }
 
 fn default_max_pace() -> f64 {
-    8.0
+    2.0
 }
 
 impl LoadingSpec {
