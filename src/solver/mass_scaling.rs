@@ -55,10 +55,10 @@ pub fn scale_masses<const D: usize, const K: usize>(
         ..Default::default()
     };
     let mut added = 0.0;
-    for i in 0..mech.len() {
+    for (i, &r) in rows.iter().enumerate() {
         let m = mech.mass[i];
-        if rows[i] > limit * m {
-            let scaled = rows[i] / limit;
+        if r > limit * m {
+            let scaled = r / limit;
             added += scaled - m;
             report.particles += 1;
             report.largest_factor = report.largest_factor.max(scaled / m);

@@ -155,8 +155,7 @@ fn mass_scaling_raises_the_step_and_reports_what_it_added() {
     assert!(ratio <= 0.01 && w.is_empty(), "{ratio} {w:?}");
     for q in ["0", "1.5", "-0.2"] {
         let e = Scene::from_file(file, &[format!("solver.mass_scaling={q}")])
-            .err()
-            .expect("refused")
+            .expect_err("refused")
             .to_string();
         assert!(
             e.contains("solver.mass_scaling") && e.contains("0 < mass_scaling <= 1"),
