@@ -155,7 +155,7 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
         mech.c_in[i] = 2.0 * mech.mass[i] * scene.damping.internal * omega_i;
         mech.c_ex[i] = 2.0 * mech.mass[i] * scene.damping.external * omega_struct;
     }
-    let share = match scene.damping.bond_scheme_in(scene.dim()) {
+    let share = match scene.damping.bond_scheme {
         BondScheme::Explicit => 0.0,
         BondScheme::SemiImplicit => split_bond_dampers(&mut model.mech, &model.particles.x0),
     };

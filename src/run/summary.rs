@@ -392,7 +392,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         offset_m: d.offset.clone(),
         omega_max_rad_s: p.stable.omega_max,
         omega_max_bound_rad_s: p.stable.omega_max_bound,
-        bond_damper_scheme: p.model.scene.damping.bond_scheme_in(p.model.scene.dim()),
+        bond_damper_scheme: p.model.scene.damping.bond_scheme,
         bond_damping_ratio_at_omega_max: p.stable.zeta,
         bond_damper_implicit_share: p.stable.implicit_share,
         mass_scaling: p.mass_scaling,

@@ -45,9 +45,9 @@ pub struct LoadingSpec {
     #[serde(default)]
     pub stop_after_peak: Option<f64>,
     /// How fast the explicit run reads the ramp: `fixed` (in time) or `adaptive`
-    /// (docs/model.md §10, "Adaptive pace"); left out, [`LoadingSpec::pace_of`] decides.
-    #[serde(default)]
-    pub pace: Option<Pace>,
+    /// (docs/model.md §10, "Adaptive pace").
+    #[serde(default = "default_pace")]
+    pub pace: Pace,
     /// The largest pace factor of an adaptive pace.
     #[serde(default = "default_max_pace")]
     pub max_pace: f64,
@@ -77,17 +77,8 @@ fn default_max_pace() -> f64 {
     2.0
 }
 
-impl LoadingSpec {
-    /// The pace of a `dim`-dimensional explicit run, `fracture` with `[concrete]`: the key's
-    /// value; left out, adaptive for fracture in 3D (benchmarks/RESULTS.md, "Adaptive pace")
-    /// and fixed otherwise (2D: the validated records; an elastic run has no tail).
-    pub fn pace_of(&self, dim: usize, fracture: bool) -> Pace {
-        self.pace.unwrap_or(if dim == 3 && fracture {
-            Pace::Adaptive
-        } else {
-            Pace::Fixed
-        })
-    }
+fn default_pace() -> Pace {
+    Pace::Fixed
 }
 
 impl Default for LoadingSpec {
@@ -98,7 +89,7 @@ impl Default for LoadingSpec {
             end_periods: None,
             end_s: None,
             stop_after_peak: None,
-            pace: None,
+            pace: default_pace(),
             max_pace: default_max_pace(),
         }
     }
@@ -129,10 +120,13 @@ pub struct DampingSpec {
     /// ξ_ex, particle-velocity dampers on the fundamental mode (3.56).
     #[serde(default)]
     pub external: f64,
-    /// How the explicit step integrates the bond dampers (docs/model.md §5); left out,
-    /// [`DampingSpec::bond_scheme_in`] decides by the dimension.
-    #[serde(default)]
-    pub bond_scheme: Option<BondScheme>,
+    /// How the explicit step integrates the bond dampers (docs/model.md §5).
+    #[serde(default = "default_bond_scheme")]
+    pub bond_scheme: BondScheme,
+}
+
+fn default_bond_scheme() -> BondScheme {
+    BondScheme::Explicit
 }
 
 /// How the explicit step integrates the bond dampers (docs/model.md §5).
@@ -140,7 +134,8 @@ pub struct DampingSpec {
 #[serde(rename_all = "snake_case")]
 pub enum BondScheme {
     /// Wholly at v^{n−½} (3.55): the dampers lower the stable step,
-    /// Δt ≤ (2/ω_max)(√(1+ζ²) − ζ).
+    /// Δt ≤ (2/ω_max)(√(1+ζ²) − ζ). The default: the scheme the crack bands were calibrated
+    /// with (benchmarks/RESULTS.md, "Bond dampers that keep the undamped step").
     Explicit,
     /// A diagonal share implicitly (S.17): the stable step is the undamped one, 2/ω_max.
     SemiImplicit,
@@ -156,25 +151,12 @@ impl BondScheme {
     }
 }
 
-impl DampingSpec {
-    /// The scheme of a `dim`-dimensional run: the key's value; left out, semi-implicit in 3D
-    /// (where the explicit dampers cut the step 4–8×: benchmarks/RESULTS.md, "Bond dampers
-    /// that keep the undamped step") and explicit in 2D (the validated records).
-    pub fn bond_scheme_in(&self, dim: usize) -> BondScheme {
-        self.bond_scheme.unwrap_or(if dim == 3 {
-            BondScheme::SemiImplicit
-        } else {
-            BondScheme::Explicit
-        })
-    }
-}
-
 impl Default for DampingSpec {
     fn default() -> Self {
         DampingSpec {
             internal: 0.0,
             external: 0.0,
-            bond_scheme: None,
+            bond_scheme: default_bond_scheme(),
         }
     }
 }

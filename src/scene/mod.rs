@@ -504,8 +504,7 @@ impl Scene {
     /// How an explicit run of this scene reads its ramp (`loading.pace`, docs/model.md §10);
     /// `None` for the relaxation and quasi-static solvers, whose increments set the pace.
     pub fn pace(&self) -> Option<Pace> {
-        (!self.solver.method.is_incremental())
-            .then(|| self.loading.pace_of(self.dim(), self.concrete.is_some()))
+        (!self.solver.method.is_incremental()).then_some(self.loading.pace)
     }
 
     /// Parse TOML text, apply `key=value` overrides, and validate.

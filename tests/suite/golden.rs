@@ -58,14 +58,11 @@ const GOLDEN: &[Golden] = &[
     // in 3D"). Re-recorded again when the FCC cells began to be built by the random
     // particles' nearest-first clipping (`voronoi3::nearest_first_cell`): the same cells cut
     // in another order, so the volumes and the peak move in the last bits (3e-13 relative).
-    // Re-recorded when 3D runs took the bond dampers semi-implicitly by default
-    // (docs/model.md §5, (S.17)): the undamped step, 10,849 steps instead of 45,589, the peak
-    // 8178.498 N instead of 8177.868 N (+7.7e-5).
     Golden {
         scene: "elastic_block_3d",
-        peak_force_n: 8178.498161030765,
-        dissipated_energy_j: -1.581370071782745e-12,
-        steps: 10849,
+        peak_force_n: 8177.8683365576435,
+        dissipated_energy_j: -3.8792387813298135e-14,
+        steps: 45589,
         particles: 11523,
     },
     Golden {

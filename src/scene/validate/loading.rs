@@ -68,14 +68,13 @@ impl Scene {
                 "a factor from 1 to 100 (how much faster than the ramp an adaptive pace may read it)",
             ));
         }
-        if let Some(p) = self.loading.pace {
-            if p == crate::scene::Pace::Adaptive && self.solver.method.is_incremental() {
-                return Err(invalid(
-                    "loading.pace",
-                    "\"adaptive\"",
-                    format!("\"fixed\" with solver.method = \"{}\" (its load increments set their own pace); \"adaptive\" only with solver.method = \"explicit\"", self.solver.method.name()),
-                ));
-            }
+        if self.loading.pace == crate::scene::Pace::Adaptive && self.solver.method.is_incremental()
+        {
+            return Err(invalid(
+                "loading.pace",
+                "\"adaptive\"",
+                format!("\"fixed\" with solver.method = \"{}\" (its load increments set their own pace); \"adaptive\" only with solver.method = \"explicit\"", self.solver.method.name()),
+            ));
         }
         Ok(())
     }
