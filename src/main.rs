@@ -232,7 +232,7 @@ fn bench(args: &BenchArgs) -> anyhow::Result<ExitCode> {
     if dim == 3 {
         anyhow::ensure!(
             ["hexagonal", "fcc", "random"].contains(&lattice.as_str()),
-            "--lattice {lattice} with --dim 3: \"fcc\" (the FCC lattice) or \"random\" (random particles, elastic kernel)"
+            "--lattice {lattice} with --dim 3: \"fcc\" (the FCC lattice) or \"random\" (random particles)"
         );
     }
     anyhow::ensure!(particles >= 10, "--particles {particles}: at least 10");
@@ -248,7 +248,7 @@ fn bench(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         "--threads {threads}: at most 4096 worker threads"
     );
     let r = if dim == 3 && lattice == "random" {
-        sppm::bench::bench_random3(particles, steps.max(1), threads, kernel)
+        sppm::bench::bench_random3(particles, steps.max(1), threads, kernel, !scalar)
     } else if dim == 3 {
         sppm::bench::bench_fcc(particles, steps.max(1), threads, kernel, !scalar)
     } else {

@@ -146,9 +146,16 @@ where
             return;
         }
         // The principal strains where tensile damage needs ε_I; elsewhere ε_eff comes from
-        // the invariants (no eigenvalue solve in 3D).
-        let principal = (p.initiated || initiates_now)
-            .then(|| Dim::<D>::principal_strains(&eps, law.nu, law.plane));
+        // the invariants (no eigenvalue solve in 3D). The tension kernel needs ε_I alone
+        // (in 3D a third of the eigenvalue solve's cosines).
+        let principal = (p.initiated || initiates_now).then(|| {
+            if FULL {
+                Dim::<D>::principal_strains(&eps, law.nu, law.plane)
+            } else {
+                let e1 = Dim::<D>::principal_strain_max(&eps, law.nu, law.plane);
+                (e1, f64::NAN, f64::NAN)
+            }
+        });
         if let Some((e1, _, _)) = principal {
             if initiates_now {
                 p.initiated = true;

@@ -143,6 +143,13 @@ pub trait Dimension<const D: usize>: Copy + Default + Debug + Send + Sync + 'sta
     /// (0 in plane strain, −ν/(1−ν)·(ε1+ε2) in plane stress), not sorted against ε1, ε2.
     /// 3D: the three principal values, descending.
     fn principal_strains(e: &Tensor<D>, nu: f64, plane: Plane) -> (f64, f64, f64);
+    /// The largest in-plane (2D) or largest (3D) principal strain ε1 of
+    /// [`Dimension::principal_strains`], bit for bit, where the others are not needed (the
+    /// tension kernel's damage law, §8): in 3D at a third of the cosines ([`principal_max_3`]).
+    #[inline(always)]
+    fn principal_strain_max(e: &Tensor<D>, nu: f64, plane: Plane) -> f64 {
+        Self::principal_strains(e, nu, plane).0
+    }
     /// (σ_max, σ_min): the largest and smallest principal stress including, in 2D, the
     /// out-of-plane σ_zz ([`out_of_plane_stress`]) — the pair the concrete
     /// criteria take (§8, `damage::initiates`).
@@ -576,13 +583,69 @@ impl Layout<3, 6> for Voigt6 {
 /// error of round-off times ‖s‖³. So the angle, and the eigenvalues, are accurate to a few
 /// ulps of ‖t‖ whatever the eigenvalue gaps (`tests::principal_values_3_match_nalgebra`).
 pub fn principal_values_3(t: &Matrix3<f64>) -> [f64; 3] {
+    let (m, scale, r, theta) = match deviator_angle(t) {
+        Deviator::Zero { m } => return [m, m, m],
+        Deviator::Angle { m, scale, r, theta } => (m, scale, r, theta),
+    };
+    let third = 2.0 * std::f64::consts::FRAC_PI_3;
+    let mut p = [
+        r * theta.cos(),
+        r * (theta - third).cos(),
+        r * (theta + third).cos(),
+    ];
+    // Sorted by construction for θ ∈ [0, π/3]; round-off may swap near-equal values.
+    if p[1] > p[0] {
+        p.swap(0, 1);
+    }
+    if p[2] > p[1] {
+        p.swap(1, 2);
+        if p[1] > p[0] {
+            p.swap(0, 1);
+        }
+    }
+    [m + p[0] * scale, m + p[1] * scale, m + p[2] * scale]
+}
+
+/// The largest principal value of a symmetric 3×3 tensor, bit for bit
+/// `principal_values_3(t)[0]` (`tests::principal_values_3_match_nalgebra`) at a third of its
+/// cosines: with θ ∈ [0, π/3], cos(θ + 2π/3) ≤ −½ < ½ ≤ cos θ, and cos θ − cos(θ − 2π/3) =
+/// √3·sin(π/3 − θ), so cos θ is the largest of the three, computed as well as exactly, unless
+/// θ is within 1e-6 of π/3 (two largest values nearly equal), where all three are computed and
+/// sorted as `principal_values_3` sorts them.
+pub fn principal_max_3(t: &Matrix3<f64>) -> f64 {
+    match deviator_angle(t) {
+        Deviator::Angle { m, scale, r, theta } if theta < std::f64::consts::FRAC_PI_3 - 1e-6 => {
+            m + r * theta.cos() * scale
+        }
+        _ => principal_values_3(t)[0],
+    }
+}
+
+/// The deviator of a symmetric 3×3 tensor in the form its principal values take
+/// ([`principal_values_3`]): the mean m and either a zero deviator, or the scale, the radius
+/// r = 2√(J2/3) and the angle θ = atan2(√Δ, 3√3·J3)/3 of the scaled deviator.
+enum Deviator {
+    Zero {
+        m: f64,
+    },
+    Angle {
+        m: f64,
+        scale: f64,
+        r: f64,
+        theta: f64,
+    },
+}
+
+/// [`Deviator`] of t (only the lower triangle is read).
+#[inline]
+fn deviator_angle(t: &Matrix3<f64>) -> Deviator {
     let m = (t[(0, 0)] + t[(1, 1)] + t[(2, 2)]) / 3.0;
     let (a, b, c) = (t[(0, 0)] - m, t[(1, 1)] - m, t[(2, 2)] - m);
     let (xy, yz, xz) = (t[(1, 0)], t[(2, 1)], t[(2, 0)]);
     // Scale (a sum keeps NaN); zero deviator: three equal values.
     let scale = a.abs() + b.abs() + c.abs() + xy.abs() + yz.abs() + xz.abs();
     if scale == 0.0 {
-        return [m, m, m];
+        return Deviator::Zero { m };
     }
     let k = 1.0 / scale;
     let (a, b, c, xy, yz, xz) = (a * k, b * k, c * k, xy * k, yz * k, xz * k);
@@ -620,23 +683,7 @@ pub fn principal_values_3(t: &Matrix3<f64>) -> [f64; 3] {
     let disc_sqrt = (3.0 * gram).sqrt();
     let theta = disc_sqrt.atan2(3.0 * 3f64.sqrt() * j3) / 3.0;
     let r = 2.0 * (j2 / 3.0).sqrt();
-    let third = 2.0 * std::f64::consts::FRAC_PI_3;
-    let mut p = [
-        r * theta.cos(),
-        r * (theta - third).cos(),
-        r * (theta + third).cos(),
-    ];
-    // Sorted by construction for θ ∈ [0, π/3]; round-off may swap near-equal values.
-    if p[1] > p[0] {
-        p.swap(0, 1);
-    }
-    if p[2] > p[1] {
-        p.swap(1, 2);
-        if p[1] > p[0] {
-            p.swap(0, 1);
-        }
-    }
-    [m + p[0] * scale, m + p[1] * scale, m + p[2] * scale]
+    Deviator::Angle { m, scale, r, theta }
 }
 
 impl Dimension<3> for Dim<3> {
@@ -683,6 +730,11 @@ impl Dimension<3> for Dim<3> {
     fn principal_strains(e: &Matrix3<f64>, _nu: f64, _plane: Plane) -> (f64, f64, f64) {
         let [e1, e2, e3] = principal_values_3(e);
         (e1, e2, e3)
+    }
+    /// ε1 alone ([`principal_max_3`]); `nu` and `plane` are ignored.
+    #[inline]
+    fn principal_strain_max(e: &Matrix3<f64>, _nu: f64, _plane: Plane) -> f64 {
+        principal_max_3(e)
     }
     /// (σ1, σ3); `nu` and `plane` are ignored.
     #[inline]

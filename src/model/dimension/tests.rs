@@ -414,6 +414,15 @@ fn check_principal_3(t: &Matrix3<f64>, what: &str) -> f64 {
         );
     }
     assert_eq!(<D3 as Dimension<3>>::principal_values(t), p);
+    assert_eq!(
+        principal_max_3(t).to_bits(),
+        p[0].to_bits(),
+        "{what}: largest"
+    );
+    assert_eq!(
+        <D3 as Dimension<3>>::principal_strain_max(t, 0.2, Plane::Stress).to_bits(),
+        p[0].to_bits()
+    );
     (0..3).map(|k| (p[k] - ev[k]).abs()).fold(0.0, f64::max) / t.norm().max(f64::MIN_POSITIVE)
 }
 
@@ -815,6 +824,7 @@ fn three_d_voigt_round_trips_and_projector_reads_strain() {
             <D3 as Dimension<3>>::von_mises(&t)
         );
         let p = principal_values_3(&t);
+        assert_eq!(principal_max_3(&t).to_bits(), p[0].to_bits());
         assert_eq!(
             <D3 as Dimension<3>>::principal_stress_extremes(&t, nu, Plane::Strain),
             (p[0], p[2])

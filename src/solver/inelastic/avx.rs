@@ -12,10 +12,10 @@ use crate::discretise::NONE;
 use crate::model::damage_law::DamageLaw;
 use crate::model::dimension::{Dim, Dimension};
 use crate::solver::kernel::avx::{
-    block_slots, gather, gather_vec, geometry, load_own, slot, update_block,
+    block_slots, gather, gather_vec, geometry, load_own, slot, update_block, vector_update,
 };
 use crate::solver::kernel::LANES;
-use crate::solver::kernel::{ChunkOut, StateReads};
+use crate::solver::kernel::{central_difference, ChunkOut, StateReads};
 use crate::solver::mechanics::Mechanics;
 use core::arch::x86_64::*;
 use nalgebra::SVector;
@@ -334,13 +334,13 @@ where
 }
 
 /// Pass 2 over whole blocks of four: the forces (`force_block`) and the central-difference
-/// update (`kernel::avx::update_block`) of particles base.. into `out`, a multiple of four
-/// of them.
+/// update of particles base.. into `out`, a multiple of four of them: four lanes at once
+/// (`kernel::avx::update_block`) where [`vector_update`] holds (2D), otherwise lane by lane
+/// through the scalar `kernel::central_difference` (3D, as the elastic kernel does).
 ///
 /// # Safety
-/// AVX available; `kernel::avx::vector_update::<D>()`; base + out.xn.len() ≤ m.len() and
-/// every array of `r` has m.len() entries; every occupied slot indexes a particle; pass 1
-/// filled the slot cache at positions r.x.
+/// AVX available; base + out.xn.len() ≤ m.len() and every array of `r` has m.len() entries;
+/// every occupied slot indexes a particle; pass 1 filled the slot cache at positions r.x.
 #[target_feature(enable = "avx")]
 pub(super) unsafe fn update_chunk<
     const D: usize,
@@ -359,23 +359,51 @@ pub(super) unsafe fn update_chunk<
     Dim<D>: Dimension<D>,
 {
     let ChunkOut { xn, vn, fo, dw } = out;
+    let vector = vector_update::<D>();
     for o0 in (0..xn.len()).step_by(LANES) {
         let i0 = base + o0;
         let (f, power) = force_block::<D, K, L, DAMP>(m, c, r, i0);
-        update_block::<D, K, LAG, DAMP>(
-            m,
-            r.x,
-            r.v,
-            r.force_prev,
-            dt,
-            i0,
-            o0,
-            &f,
-            power,
-            xn,
-            vn,
-            fo,
-            dw,
-        );
+        if vector {
+            update_block::<D, K, LAG, DAMP>(
+                m,
+                r.x,
+                r.v,
+                r.force_prev,
+                dt,
+                i0,
+                o0,
+                &f,
+                power,
+                xn,
+                vn,
+                fo,
+                dw,
+            );
+            continue;
+        }
+        let fa = f.map(|fc| lanes(fc));
+        let pa = lanes(power);
+        for l in 0..LANES {
+            let (i, o) = (i0 + l, o0 + l);
+            let fl = SVector::<f64, D>::from_fn(|cc, _| fa[cc][l]);
+            *fo.get_unchecked_mut(o) = fl;
+            let drive = if LAG {
+                *r.force_prev.get_unchecked(i)
+            } else {
+                fl
+            };
+            central_difference::<D, K, DAMP>(
+                m,
+                i,
+                *r.x.get_unchecked(i),
+                *r.v.get_unchecked(i),
+                drive,
+                pa[l],
+                dt,
+                xn.get_unchecked_mut(o),
+                vn.get_unchecked_mut(o),
+                dw.get_unchecked_mut(o),
+            );
+        }
     }
 }

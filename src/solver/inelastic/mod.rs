@@ -17,9 +17,10 @@
 //!    blocks of four particles).
 //! 2. Each particle gathers F_b,ij = ½(d_ij·(a_i + a_j)·S_e,ij + √d_ij·(bθ_i + bθ_j)) along
 //!    e_ij, with the bond damper scaled by d_ij, and integrates; e_ij and √d_ij are
-//!    recomputed as pass 1 computed them. With AVX in 2D, four particles at a time
+//!    recomputed as pass 1 computed them. With AVX, four particles at a time
 //!    (`avx::force_block`, for any law: it reads only the slot cache and the positions),
-//!    bit-identical to `particle_force` (the same test, three whole steps).
+//!    bit-identical to `particle_force` (the same test, three whole steps); the
+//!    central-difference update is four lanes wide in 2D and lane by lane in 3D.
 //!
 //! **Decision (erratum to (3.36)).** As written, F_s,ij = d_ij·a·S_e,ij + b·Σ_m d_im·S_e,im
 //! leaves the dilatation term on a bond whose particle is fully damaged: a broken particle i

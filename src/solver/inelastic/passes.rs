@@ -502,7 +502,7 @@ pub fn step<
     debug_assert!(FULL || c.kernel() == KernelSet::Tension);
     pass_state::<D, K, L, FULL>(m, c, &st.x, &mut st.b_theta);
     #[cfg(target_arch = "x86_64")]
-    let avx = c.simd && use_avx() && crate::solver::kernel::avx::vector_update::<D>();
+    let avx = c.simd && use_avx();
     #[cfg(not(target_arch = "x86_64"))]
     let avx = false;
     let cr = &*c;
@@ -511,8 +511,8 @@ pub fn step<
         let done = if avx { len / LANES * LANES } else { 0 };
         #[cfg(target_arch = "x86_64")]
         if done > 0 {
-            // SAFETY: AVX is available and D = 2 with 16-byte vectors (checked above);
-            // base + len ≤ m.len() and every state array has m.len() entries
+            // SAFETY: AVX is available (checked above); base + len ≤ m.len() and every
+            // state array has m.len() entries
             // (update_in_chunks asserts it); pass 1 filled the slot cache of every particle.
             unsafe {
                 super::avx::update_chunk::<D, K, L, LAG, DAMP>(m, cr, &r, dt, base, out.head(done))
