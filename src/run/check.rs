@@ -84,37 +84,7 @@ where
     say!("fundamental T1   {:.6e} s", p.fundamental.period);
     say!("stable dt        {:.6e} s", p.stable.dt_stable);
     say!("time step dt     {:.6e} s", p.dt);
-    if p.stable.implicit_share > 0.0 {
-        let z = p.stable.zeta;
-        say!(
-            "bond dampers     semi_implicit, σ = {:.3} (S.17); ζ = {z:.2} at ω_max, which would need dt ≤ {:.6e} s explicit",
-            p.stable.implicit_share,
-            p.stable.dt_stable * ((1.0 + z * z).sqrt() - z)
-        );
-    }
-    if let Some(pace) = sc.pace() {
-        say!(
-            "pace             {}{}",
-            pace.name(),
-            if pace == crate::scene::Pace::Adaptive {
-                format!(
-                    ": up to {}× on the post-peak tail, so fewer steps than below",
-                    sc.loading.max_pace
-                )
-            } else {
-                String::new()
-            }
-        );
-    }
-    if let Some(m) = &p.mass_scaling {
-        say!(
-            "mass scaling     {} particles raised to {} × the median particle's step: {:.3}% of the mass added, the largest factor {:.2}",
-            m.particles,
-            m.fraction_of_median_step,
-            100.0 * m.added_mass_fraction,
-            m.largest_factor
-        );
-    }
+    say_fast_options(sc, &p);
     let threads = rayon::current_num_threads();
     let solver = &sc.solver;
     if solver.method == SolverMethod::QuasiStatic && sc.concrete.is_some() {
@@ -191,4 +161,40 @@ where
         );
     }
     Ok(())
+}
+
+/// What `sppm check` says of the fast options a scene turned on: the semi-implicit bond
+/// dampers (S.17), the pace (docs/model.md §10) and selective mass scaling (S.18).
+fn say_fast_options<const K: usize, const D: usize>(sc: &Scene, p: &Prepared<K, D>) {
+    if p.stable.implicit_share > 0.0 {
+        let z = p.stable.zeta;
+        say!(
+            "bond dampers     semi_implicit, σ = {:.3} (S.17); ζ = {z:.2} at ω_max, which would need dt ≤ {:.6e} s explicit",
+            p.stable.implicit_share,
+            p.stable.dt_stable * ((1.0 + z * z).sqrt() - z)
+        );
+    }
+    if let Some(pace) = sc.pace() {
+        say!(
+            "pace             {}{}",
+            pace.name(),
+            if pace == crate::scene::Pace::Adaptive {
+                format!(
+                    ": up to {}× on the post-peak tail, so fewer steps than below",
+                    sc.loading.max_pace
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
+    if let Some(m) = &p.mass_scaling {
+        say!(
+            "mass scaling     {} particles raised to {} × the median particle's step: {:.3}% of the mass added, the largest factor {:.2}",
+            m.particles,
+            m.fraction_of_median_step,
+            100.0 * m.added_mass_fraction,
+            m.largest_factor
+        );
+    }
 }
