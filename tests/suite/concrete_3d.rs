@@ -360,3 +360,65 @@ fn interaction_initiation_on_the_fcc_lattice() {
         }
     }
 }
+
+/// On a law without compressive damage and plasticity the tension kernel (docs/model.md §17,
+/// "Kernel sets") gives the full kernel's states and forces bit for bit on the FCC lattice
+/// through loading, unloading and reloading: its largest principal strain alone is the full
+/// kernel's ε1, damage held while the strain falls and growing again past its maximum.
+#[test]
+fn tension_kernel_matches_the_full_kernel_in_3d_through_unloading() {
+    use sppm::solver::KernelSet;
+    let (p, m) = fcc_block();
+    let strained = strained(&p);
+    // multiples of the strain of `strained`: initiation near 0.86, softening, unloading,
+    // reloading past the earlier maximum
+    let path = [
+        0.5, 1.0, 1.5, 2.0, 2.5, 2.0, 1.5, 1.8, 2.2, 2.5, 2.8, 2.0, 1.0,
+    ];
+    let mut runs = Vec::new();
+    for force_full in [false, true] {
+        let mut c: DamageKernel<3, 18> = DamageKernel::new(TwoSpring::new(law(), None), &p);
+        c.force_full = force_full;
+        let mut history = Vec::new();
+        for s in path {
+            let x: Vec<Vector3<f64>> =
+                p.x0.iter()
+                    .zip(&strained)
+                    .map(|(x0, x1)| x0 + (x1 - x0) * s)
+                    .collect();
+            let f = inelastic::internal_forces(&m, &mut c, &x);
+            c.commit();
+            history.push((f, c.committed.to_vec()));
+        }
+        runs.push((c.kernel(), history));
+    }
+    assert_eq!(runs[0].0, KernelSet::Tension);
+    assert_eq!(runs[1].0, KernelSet::Full);
+    // damage grew while loading and held while unloading
+    let damaged = |step: usize| {
+        runs[0].1[step]
+            .1
+            .iter()
+            .filter(|d| d.wt > 0.0 && d.wt < 1.0)
+            .count()
+    };
+    assert!(damaged(4) > p.len() / 2, "{} of {}", damaged(4), p.len());
+    assert_eq!(
+        runs[0].1[4].1, runs[0].1[6].1,
+        "unloading changes no damage"
+    );
+    assert_ne!(
+        runs[0].1[6].1, runs[0].1[10].1,
+        "reloading past the maximum does"
+    );
+    for (step, ((ft, st), (ff, sf))) in runs[0].1.iter().zip(&runs[1].1).enumerate() {
+        assert_eq!(st, sf, "states at step {step}");
+        for (a, b) in ft.iter().zip(ff) {
+            assert_eq!(
+                a.map(f64::to_bits),
+                b.map(f64::to_bits),
+                "forces at step {step}"
+            );
+        }
+    }
+}
