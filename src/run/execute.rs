@@ -17,7 +17,7 @@ use crate::model::two_spring::TwoSpring;
 use crate::scene::{Pace, Scene, SolverMethod};
 use crate::solver::inelastic::DamageKernel;
 use crate::solver::mechanics::{weighted, Mechanics};
-use crate::solver::pace::{Observed, PaceSettings, Pacer, PACE_KINETIC, PACE_TAIL};
+use crate::solver::pace::{Observed, PaceSettings, Pacer};
 use crate::solver::{relaxation, Integration, PeakStop, Probe, Record, Simulation};
 use nalgebra::{SMatrix, SVector};
 use std::time::Instant;
@@ -403,8 +403,6 @@ fn pacer<const K: usize, const D: usize>(p: &Prepared<K, D>, probe: &Probe) -> O
         Pacer::new(
             PaceSettings {
                 max: l.max_pace,
-                tail: PACE_TAIL,
-                kinetic: PACE_KINETIC,
                 period: p.fundamental.period,
             },
             if probe.amplitude < 0.0 { -1.0 } else { 1.0 },

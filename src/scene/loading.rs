@@ -141,16 +141,6 @@ pub enum BondScheme {
     SemiImplicit,
 }
 
-impl BondScheme {
-    /// The key's value.
-    pub fn name(self) -> &'static str {
-        match self {
-            BondScheme::Explicit => "explicit",
-            BondScheme::SemiImplicit => "semi_implicit",
-        }
-    }
-}
-
 impl Default for DampingSpec {
     fn default() -> Self {
         DampingSpec {

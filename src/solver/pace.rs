@@ -3,8 +3,8 @@
 //! (dτ/dt = 1) up to and through the peak.
 //!
 //! The pace factor f = dτ/dt aims at `max` once a particle has failed and the probe force has
-//! fallen below `tail` × the peak, unless the kinetic energy exceeds `kinetic` × the largest
-//! elastic energy so far; elsewhere it aims at 1. f moves towards its aim by at most
+//! fallen below [`PACE_TAIL`] × the peak, unless the kinetic energy exceeds [`PACE_KINETIC`] ×
+//! the largest elastic energy so far; elsewhere it aims at 1. f moves towards its aim by at most
 //! (max − 1)·Δt/T_1 a step, so that a change of pace takes one fundamental period and does
 //! not jolt the specimen.
 
@@ -26,10 +26,6 @@ pub const PACE_KINETIC: f64 = 0.05;
 pub struct PaceSettings {
     /// The largest pace factor (`loading.max_pace`).
     pub max: f64,
-    /// The share of the peak force below which the post-peak tail runs at `max`.
-    pub tail: f64,
-    /// The kinetic-to-elastic energy ratio above which the pace falls back to 1.
-    pub kinetic: f64,
     /// T_1 (s).
     pub period: f64,
 }
@@ -69,13 +65,12 @@ impl Pacer {
 
     /// Set the aim from a record.
     pub fn observe(&mut self, o: Observed<'_>) {
-        let s = &self.settings;
         let f = self.sign * o.record.force_n;
         self.peak = self.peak.max(f);
         self.largest_elastic = self.largest_elastic.max(o.record.internal_j);
-        let calm = o.record.kinetic_j <= s.kinetic * self.largest_elastic;
-        let tail = o.failed && self.peak > 0.0 && f < s.tail * self.peak;
-        self.aim = if calm && tail { s.max } else { 1.0 };
+        let calm = o.record.kinetic_j <= PACE_KINETIC * self.largest_elastic;
+        let tail = o.failed && self.peak > 0.0 && f < PACE_TAIL * self.peak;
+        self.aim = if calm && tail { self.settings.max } else { 1.0 };
     }
 
     /// The pace factor of the next step of length `dt`, moved towards the aim.
@@ -83,11 +78,6 @@ impl Pacer {
         let s = &self.settings;
         let most = (s.max - 1.0) * dt / s.period;
         self.factor += (self.aim - self.factor).clamp(-most, most);
-        self.factor
-    }
-
-    /// The current pace factor.
-    pub fn factor(&self) -> f64 {
         self.factor
     }
 }
@@ -108,8 +98,6 @@ mod tests {
     fn settings() -> PaceSettings {
         PaceSettings {
             max: 5.0,
-            tail: 0.5,
-            kinetic: 0.05,
             period: 1.0,
         }
     }
@@ -142,10 +130,8 @@ mod tests {
         assert!((factors[9] - 5.0).abs() < 1e-12 && factors[11] == 5.0);
         // ringing above the limit: back to 1 over a period
         see(&mut p, 9.0, 0.06, true);
-        for _ in 0..10 {
-            p.next(0.1);
-        }
-        assert!((p.factor() - 1.0).abs() < 1e-12);
+        let last = (0..10).map(|_| p.next(0.1)).last().unwrap();
+        assert!((last - 1.0).abs() < 1e-12);
     }
 
     /// A compressive probe (negative forces) finds its peak and tail the same way.

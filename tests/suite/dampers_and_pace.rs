@@ -3,8 +3,8 @@
 //! results of the schemes they replace.
 
 use crate::common::*;
-use sppm::run::{build_simulation, prepare, run, Prepared, RunOptions};
-use sppm::solver::{Probe, Simulation, Unstable};
+use crate::stability::forced;
+use sppm::run::{prepare, run, RunOptions};
 use sppm::Scene;
 
 fn quiet() -> RunOptions {
@@ -24,24 +24,6 @@ fn block(overrides: &[&str]) -> Scene {
     ];
     o.extend(overrides.iter().map(|s| s.to_string()));
     Scene::from_file(std::path::Path::new("lattices/uniaxial_tension.toml"), &o).unwrap()
-}
-
-/// Run `p` at `dt` for at most `steps`, checking stability at every step as the run loop does.
-fn forced(p: &mut Prepared, dt: f64, steps: usize) -> (Simulation<2, 6>, Option<Unstable>) {
-    let mut sim = build_simulation(p);
-    sim.integration.dt = dt;
-    let probe = Probe {
-        members: vec![],
-        component: 1,
-        amplitude: 0.0,
-    };
-    for _ in 0..steps {
-        let rec = sim.advance(Some(&probe)).unwrap();
-        if let Err(e) = sim.check_stability(Some(rec.internal_j), true) {
-            return (sim, Some(e));
-        }
-    }
-    (sim, None)
 }
 
 /// (S.17): with the implicit share the limit is the undamped one, 2/ω_max, although the bond

@@ -152,7 +152,11 @@ fn steps_above_the_limit_are_refused_in_the_scene() {
 
 /// Run `p` at `dt` (forced past the scene check) for at most `max_steps`, checking stability
 /// at every step as the run loop does (with the probe record's elastic energy).
-fn forced(p: &mut Prepared, dt: f64, max_steps: usize) -> (Simulation<2, 6>, Option<Unstable>) {
+pub(crate) fn forced(
+    p: &mut Prepared,
+    dt: f64,
+    max_steps: usize,
+) -> (Simulation<2, 6>, Option<Unstable>) {
     let mut sim = build_simulation(p);
     sim.integration.dt = dt;
     let probe = Probe {

@@ -396,7 +396,6 @@ pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
     fn damage(&self) -> Vec<ParticleDamage>;
     /// Whether some particle has failed (w_t or w_c ≥ 0.99).
     fn has_failed_particle(&self) -> bool;
-
     /// Hold the committed state through steps (`true`) or commit after every step (`false`,
     /// the explicit run); see [`DamageKernel::frozen`].
     fn set_frozen(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[nalgebra::SVector<f64, D>]);
@@ -473,7 +472,6 @@ where
     fn has_failed_particle(&self) -> bool {
         self.committed.iter().any(|s| self.law.view(s).failed())
     }
-
     fn set_frozen(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) {
         self.freeze(frozen, m, x)
     }
