@@ -56,7 +56,8 @@ pub enum StudyCommand {
     /// σN = P_max/(0.6·D·t) per size, Bažant type-1 and Weibull fits).
     ///
     /// The variant of size D from a scene of size D0 and spacing s0: body.size = D,
-    /// discretisation.spacing = s0·min(1, D/D0), each loaded group's displacement × D/D0.
+    /// discretisation.spacing = s0·min(1, D/D0), each loaded group's displacement × √(D/D0),
+    /// and with relaxation solver.max_iterations × max(1, D/D0).
     Montecarlo {
         scene: PathBuf,
         /// Realisations per size.
