@@ -263,6 +263,89 @@ pub fn random_block_modulus(
     block_moduli(&p, width, height, 1.5 * recipe.spacing)
 }
 
+/// The box of a 3D prism cantilever: square section h × h (y, z ∈ [0, h]), free length
+/// `length` along x, and 3·L0 behind the root (x ∈ [−3·L0, 0]) to clamp.
+pub fn prism_cantilever_box(h: f64, length: f64, spacing: f64) -> crate::geometry::Shape3 {
+    crate::geometry::Shape3::Box {
+        origin: Vector3::new(-3.0 * spacing, 0.0, 0.0),
+        size: Vector3::new(length + 3.0 * spacing, h, h),
+    }
+}
+
+/// Tip stiffness / Timoshenko's of a 3D prism cantilever of particles `p` filling
+/// [`prism_cantilever_box`]: the particles at x ≤ 0 held in x, y and z; a tip load P along z
+/// spread over the particles within one spacing of the free end in proportion to their
+/// volume; the tip deflection the load-weighted (work-conjugate) mean; Timoshenko's
+/// δ = P·a³/(3EI) + P·a/(κGA) with a the load's centroid, I = h⁴/12, A = h², κ = 5/6.
+pub fn prism_cantilever_stiffness<const K: usize>(
+    p: &crate::discretise::Particles<3, K>,
+    h: f64,
+    length: f64,
+    spacing: f64,
+) -> Result<f64, RunError> {
+    use crate::solver::mechanics::Mechanics;
+    let n = p.len();
+    let mech = Mechanics::new(p, &vec![2400.0; n]);
+    let constrained: Vec<[bool; 3]> = p.x0.iter().map(|x| [x.x <= 0.0; 3]).collect();
+    let tip: Vec<usize> = (0..n)
+        .filter(|&i| p.x0[i].x >= length - 1.01 * spacing)
+        .collect();
+    let vt: f64 = tip.iter().map(|&i| p.volume[i]).sum();
+    let load = 1000.0;
+    let mut f = vec![Vector3::zeros(); n];
+    for &i in &tip {
+        f[i].z = load * p.volume[i] / vt;
+    }
+    let arm = tip.iter().map(|&i| p.x0[i].x * p.volume[i]).sum::<f64>() / vt;
+    let u = static_force_response(&mech, &p.x0, &constrained, &f)?;
+    let delta = tip.iter().map(|&i| u[i].z * f[i].z).sum::<f64>() / load;
+    let shear = E / (2.0 * (1.0 + NU));
+    let theory = load * arm.powi(3) / (3.0 * E * h.powi(4) / 12.0)
+        + load * arm / (5.0 / 6.0 * shear * h * h);
+    Ok(theory / delta)
+}
+
+/// [`prism_cantilever_stiffness`] of an FCC lattice with the boundary treatment `surface`.
+pub fn fcc_prism_cantilever(
+    h: f64,
+    length: f64,
+    lattice: &crate::discretise::fcc::FccLattice,
+    surface: crate::scene::Surface,
+) -> Result<f64, RunError> {
+    use crate::run::generate::fcc_surface_treatment as surface_treatment;
+    let shape = prism_cantilever_box(h, length, lattice.spacing);
+    let mut p = lattice.fill(&shape);
+    surface_treatment(&mut p, &shape, surface, E, NU);
+    prism_cantilever_stiffness(&p, h, length, lattice.spacing)
+}
+
+/// [`prism_cantilever_stiffness`] of random particles (`recipe`), each with least-squares
+/// moduli fitted to the calibrated target (E*, ν*) a run fits them to
+/// (`model::sppm_calibration::fit_target_3d`).
+pub fn random_prism_cantilever(
+    h: f64,
+    length: f64,
+    recipe: &crate::discretise::random3::RandomSolid,
+) -> Result<f64, RunError> {
+    use crate::discretise::random3::{self, SLOTS_3D};
+    use crate::model::dimension::{Dim, Dimension};
+    let shape = prism_cantilever_box(h, length, recipe.spacing);
+    let (mut p, _) = random3::fill::<SLOTS_3D>(&shape, recipe).map_err(RunError::Setup)?;
+    let (e_fit, nu_fit) = crate::model::sppm_calibration::fit_target_3d(E, NU, recipe.min_distance)
+        .map_err(RunError::Setup)?;
+    let d = <Dim<3> as Dimension<3>>::elasticity(e_fit, nu_fit, crate::scene::Plane::Stress);
+    let (mut a, mut b) = (vec![0.0; p.len()], vec![0.0; p.len()]);
+    let fit = crate::run::generate::moduli::fit_moduli_3d(&p, &d, &mut a, &mut b);
+    if fit.unfitted > 0 {
+        return Err(RunError::Setup(format!(
+            "{} random particles have no moduli fit",
+            fit.unfitted
+        )));
+    }
+    (p.a, p.b) = (a, b);
+    prism_cantilever_stiffness(&p, h, length, recipe.spacing)
+}
+
 /// (E/E0, ν/ν0) of a 3D block W × W × H (z along H, lower corner at the origin) of particles
 /// with their moduli, against this module's [`E`] and [`NU`]: the rows within `band` of z = 0
 /// held in z, those within `band` of z = H pulled to a strain of 1e-4 (sides free), the
