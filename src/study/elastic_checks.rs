@@ -242,15 +242,27 @@ pub fn random_block_modulus(
     e_fit: f64,
     nu_fit: f64,
 ) -> Result<(f64, f64), RunError> {
-    use crate::discretise::random3::{self, SLOTS_3D};
     use crate::geometry::Shape3;
-    use crate::model::dimension::{Dim, Dimension};
     let shape = Shape3::Box {
         origin: Vector3::zeros(),
         size: Vector3::new(width, width, height),
     };
-    let (mut p, _) = random3::fill::<SLOTS_3D>(&shape, recipe).map_err(RunError::Setup)?;
-    let d = <Dim<3> as Dimension<3>>::elasticity(E * e_fit, nu_fit, crate::scene::Plane::Stress);
+    let p = fitted_random_solid(&shape, recipe, E * e_fit, nu_fit)?;
+    block_moduli(&p, width, height, 1.5 * recipe.spacing)
+}
+
+/// `recipe`'s random particles in `shape`, each with its least-squares (a_i, b_i) fitted to
+/// the isotropic D of (e, nu) (3.20); `Err` when a particle has no fit.
+fn fitted_random_solid(
+    shape: &crate::geometry::Shape3,
+    recipe: &crate::discretise::random3::RandomSolid,
+    e: f64,
+    nu: f64,
+) -> Result<crate::discretise::Particles<3, { crate::discretise::random3::SLOTS_3D }>, RunError> {
+    use crate::discretise::random3::{self, SLOTS_3D};
+    use crate::model::dimension::{Dim, Dimension};
+    let (mut p, _) = random3::fill::<SLOTS_3D>(shape, recipe).map_err(RunError::Setup)?;
+    let d = <Dim<3> as Dimension<3>>::elasticity(e, nu, crate::scene::Plane::Stress);
     let (mut a, mut b) = (vec![0.0; p.len()], vec![0.0; p.len()]);
     let fit = crate::run::generate::moduli::fit_moduli_3d(&p, &d, &mut a, &mut b);
     if fit.unfitted > 0 {
@@ -260,7 +272,7 @@ pub fn random_block_modulus(
         )));
     }
     (p.a, p.b) = (a, b);
-    block_moduli(&p, width, height, 1.5 * recipe.spacing)
+    Ok(p)
 }
 
 /// The box of a 3D prism cantilever: square section h × h (y, z ∈ [0, h]), free length
@@ -327,22 +339,10 @@ pub fn random_prism_cantilever(
     length: f64,
     recipe: &crate::discretise::random3::RandomSolid,
 ) -> Result<f64, RunError> {
-    use crate::discretise::random3::{self, SLOTS_3D};
-    use crate::model::dimension::{Dim, Dimension};
     let shape = prism_cantilever_box(h, length, recipe.spacing);
-    let (mut p, _) = random3::fill::<SLOTS_3D>(&shape, recipe).map_err(RunError::Setup)?;
     let (e_fit, nu_fit) = crate::model::sppm_calibration::fit_target_3d(E, NU, recipe.min_distance)
         .map_err(RunError::Setup)?;
-    let d = <Dim<3> as Dimension<3>>::elasticity(e_fit, nu_fit, crate::scene::Plane::Stress);
-    let (mut a, mut b) = (vec![0.0; p.len()], vec![0.0; p.len()]);
-    let fit = crate::run::generate::moduli::fit_moduli_3d(&p, &d, &mut a, &mut b);
-    if fit.unfitted > 0 {
-        return Err(RunError::Setup(format!(
-            "{} random particles have no moduli fit",
-            fit.unfitted
-        )));
-    }
-    (p.a, p.b) = (a, b);
+    let p = fitted_random_solid(&shape, recipe, e_fit, nu_fit)?;
     prism_cantilever_stiffness(&p, h, length, recipe.spacing)
 }
 
