@@ -80,7 +80,14 @@ fn prism_rows(hl: f64) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.first().is_some_and(|a| a == "--3d") {
-        let depths: Vec<f64> = args[1..].iter().filter_map(|a| a.parse().ok()).collect();
+        let depths: Vec<f64> = args[1..]
+            .iter()
+            .map(|a| {
+                a.parse().unwrap_or_else(|_| {
+                    panic!("--3d takes depths in spacings (numbers), not {a:?}")
+                })
+            })
+            .collect();
         prism_cantilevers(if depths.is_empty() { &[10.0] } else { &depths });
         return;
     }

@@ -60,24 +60,60 @@ pub fn cantilever_scene(h: f64, length: f64, p: &Placement) -> Result<Scene, Run
 pub fn cantilever_stiffness(h: f64, length: f64, p: &Placement) -> Result<(f64, Model), RunError> {
     let model = prepare_model(&cantilever_scene(h, length, p)?, Hexagonal)?;
     let x0 = &model.particles.x0;
-    let vol = &model.particles.volume;
-    let tip: Vec<usize> = (0..x0.len())
-        .filter(|&i| x0[i].x >= length - 1.01 * p.spacing)
-        .collect();
-    let vt: f64 = tip.iter().map(|&i| vol[i]).sum();
-    let load = 1000.0;
+    let tip = TipLoad::new(x0, &model.particles.volume, length, p.spacing);
     let mut f = vec![Vector2::zeros(); x0.len()];
-    for &i in &tip {
-        f[i].y = load * vol[i] / vt;
+    for &(i, share) in &tip.shares {
+        f[i].y = share;
     }
-    let arm = tip.iter().map(|&i| x0[i].x * vol[i]).sum::<f64>() / vt;
     let u = static_force_response(&model.mech, x0, &model.constrained, &f)?;
-    let delta = tip.iter().map(|&i| u[i].y * f[i].y).sum::<f64>() / load;
-    let inertia = THICKNESS * h.powi(3) / 12.0;
-    let shear = E / (2.0 * (1.0 + NU));
-    let theory =
-        load * arm.powi(3) / (3.0 * E * inertia) + load * arm / (5.0 / 6.0 * shear * THICKNESS * h);
+    let delta = tip.deflection(|i| u[i].y);
+    let theory = tip.timoshenko(THICKNESS * h.powi(3) / 12.0, THICKNESS * h);
     Ok((theory / delta, model))
+}
+
+/// A cantilever's tip load: [`TipLoad::LOAD`] spread over the particles within one spacing
+/// of the free end x = `length` in proportion to their volume.
+struct TipLoad {
+    /// (particle, its share of the load in N).
+    shares: Vec<(usize, f64)>,
+    /// The load's centroid along x (m): the lever arm from the root at x = 0.
+    arm: f64,
+}
+
+impl TipLoad {
+    const LOAD: f64 = 1000.0;
+
+    fn new<const D: usize>(
+        x0: &[nalgebra::SVector<f64, D>],
+        volume: &[f64],
+        length: f64,
+        spacing: f64,
+    ) -> TipLoad {
+        let tip: Vec<usize> = (0..x0.len())
+            .filter(|&i| x0[i][0] >= length - 1.01 * spacing)
+            .collect();
+        let vt: f64 = tip.iter().map(|&i| volume[i]).sum();
+        TipLoad {
+            shares: tip
+                .iter()
+                .map(|&i| (i, Self::LOAD * volume[i] / vt))
+                .collect(),
+            arm: tip.iter().map(|&i| x0[i][0] * volume[i]).sum::<f64>() / vt,
+        }
+    }
+
+    /// The load-weighted (work-conjugate) mean of the deflection `u` along the load.
+    fn deflection(&self, u: impl Fn(usize) -> f64) -> f64 {
+        self.shares.iter().map(|&(i, f)| u(i) * f).sum::<f64>() / Self::LOAD
+    }
+
+    /// Timoshenko's tip deflection P·a³/(3EI) + P·a/(κGA), κ = 5/6, of a section with second
+    /// moment `inertia` and area `area`.
+    fn timoshenko(&self, inertia: f64, area: f64) -> f64 {
+        let (load, arm) = (Self::LOAD, self.arm);
+        let shear = E / (2.0 * (1.0 + NU));
+        load * arm.powi(3) / (3.0 * E * inertia) + load * arm / (5.0 / 6.0 * shear * area)
+    }
 }
 
 /// A plate `width` × `height` (y ∈ [0, height]) held in y over its two bottom rows, its
@@ -299,22 +335,13 @@ pub fn prism_cantilever_stiffness<const K: usize>(
     let n = p.len();
     let mech = Mechanics::new(p, &vec![2400.0; n]);
     let constrained: Vec<[bool; 3]> = p.x0.iter().map(|x| [x.x <= 0.0; 3]).collect();
-    let tip: Vec<usize> = (0..n)
-        .filter(|&i| p.x0[i].x >= length - 1.01 * spacing)
-        .collect();
-    let vt: f64 = tip.iter().map(|&i| p.volume[i]).sum();
-    let load = 1000.0;
+    let tip = TipLoad::new(&p.x0, &p.volume, length, spacing);
     let mut f = vec![Vector3::zeros(); n];
-    for &i in &tip {
-        f[i].z = load * p.volume[i] / vt;
+    for &(i, share) in &tip.shares {
+        f[i].z = share;
     }
-    let arm = tip.iter().map(|&i| p.x0[i].x * p.volume[i]).sum::<f64>() / vt;
     let u = static_force_response(&mech, &p.x0, &constrained, &f)?;
-    let delta = tip.iter().map(|&i| u[i].z * f[i].z).sum::<f64>() / load;
-    let shear = E / (2.0 * (1.0 + NU));
-    let theory = load * arm.powi(3) / (3.0 * E * h.powi(4) / 12.0)
-        + load * arm / (5.0 / 6.0 * shear * h * h);
-    Ok(theory / delta)
+    Ok(tip.timoshenko(h.powi(4) / 12.0, h * h) / tip.deflection(|i| u[i].z))
 }
 
 /// [`prism_cantilever_stiffness`] of an FCC lattice with the boundary treatment `surface`.
