@@ -56,10 +56,29 @@ pub struct ParticleDamage {
     pub yielded: bool,
 }
 
+/// Tensile damage w_t at and above which the outputs count a particle as cracked.
+pub const CRACKED_WT: f64 = 0.99;
+
+/// Compressive damage w_c at and above which the outputs count a particle that is not
+/// cracked as crushed. Compressive damage also follows tensile damage in a crack (4.16), so
+/// a cracked particle is counted as cracked only.
+pub const CRUSHED_WC: f64 = 0.5;
+
 impl ParticleDamage {
     /// Whether the particle has failed (w_t or w_c ≥ 0.99).
     pub fn failed(&self) -> bool {
         self.wt >= 0.99 || self.wc >= 0.99
+    }
+
+    /// Cracked: w_t ≥ [`CRACKED_WT`] (summary.json's `cracked_particles`, the crack map).
+    pub fn cracked(&self) -> bool {
+        self.wt >= CRACKED_WT
+    }
+
+    /// Crushed: w_c ≥ [`CRUSHED_WC`] and not cracked (summary.json's `crushed_particles`,
+    /// the crack map's ×).
+    pub fn crushed(&self) -> bool {
+        self.wc >= CRUSHED_WC && !self.cracked()
     }
 }
 

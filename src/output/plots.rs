@@ -376,7 +376,7 @@ fn value_map(
                     .pos
                     .iter()
                     .zip(damage)
-                    .filter(|(_, d)| d.wt >= 0.99)
+                    .filter(|(_, d)| d.cracked())
                     .map(|(&p, _)| Circle::new(p, (radius / 2).max(1), BLACK.filled())),
             )
             .map_err(err)?;
@@ -431,8 +431,8 @@ pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
     let height = frame.plot_h as u32 + 130;
     let root = SVGBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
-    let cracked = damage.iter().filter(|p| p.wt >= 0.99).count();
-    let crushed = damage.iter().filter(|p| p.wc >= 0.5 && p.wt < 0.99).count();
+    let cracked = damage.iter().filter(|p| p.cracked()).count();
+    let crushed = damage.iter().filter(|p| p.crushed()).count();
     let yielded = damage.iter().filter(|p| p.yielded).count();
     let mut chart = frame.chart(
         &root,
@@ -460,7 +460,7 @@ pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
         .draw_series(
             pos.iter()
                 .zip(damage)
-                .filter(|(_, d)| d.wc >= 0.5 && d.wt < 0.99)
+                .filter(|(_, d)| d.crushed())
                 .map(|(&p, _)| Cross::new(p, (radius - 1).max(2), BLACK.stroke_width(1))),
         )
         .map_err(err)?;

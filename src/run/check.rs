@@ -59,6 +59,9 @@ where
     }
     let per_step = t.elapsed().as_secs_f64() / calib as f64;
     say!("scene            {}", sc.name());
+    for w in &sc.warnings {
+        eprintln!("warning: {w}");
+    }
     if D == 3 {
         say!(
             "lattice          {} (3D), rotation {:?}°",

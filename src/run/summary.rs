@@ -61,6 +61,11 @@ pub struct Summary {
     pub final_displacement_m: f64,
     #[serde(rename = "final_force_N")]
     pub final_force_n: f64,
+    /// The probe group is pushed in the negative direction (compression): peak_force_N and
+    /// final_force_N are its reaction with the sign turned, so positive while it resists
+    /// (force_displacement.svg turns both axes and says so); the displacements keep their
+    /// sign.
+    pub sign_turned: bool,
     /// External work not found in kinetic, elastic or damper energy (damage and plasticity;
     /// for an elastic scene a measure of the energy error).
     #[serde(rename = "dissipated_energy_J")]
@@ -83,9 +88,10 @@ pub struct Summary {
     /// Largest tensile damage w_t (scenes with `[concrete]`).
     pub max_damage: Option<f64>,
     pub max_compressive_damage: Option<f64>,
-    /// Particles with w_t ≥ 0.99.
+    /// Particles with w_t ≥ 0.99 (`ParticleDamage::cracked`, as the crack map counts them).
     pub cracked_particles: Option<usize>,
-    /// Particles with w_c ≥ 0.99.
+    /// Particles with w_c ≥ 0.5 that are not cracked (`ParticleDamage::crushed`, the crack
+    /// map's ×).
     pub crushed_particles: Option<usize>,
     /// Particles that yielded at least once.
     pub yielded_particles: Option<usize>,
@@ -360,7 +366,8 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         peak_force_n: peak.map(|r| r.force_n * sign).unwrap_or(0.0),
         displacement_at_peak_m: peak.map(|r| r.displacement_m).unwrap_or(0.0),
         final_displacement_m: last.displacement_m,
-        final_force_n: last.force_n,
+        final_force_n: last.force_n * sign,
+        sign_turned: sign < 0.0,
         dissipated_energy_j: last.external_work_j
             - last.kinetic_j
             - last.internal_j
@@ -373,8 +380,8 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         max_kinetic_to_internal_energy_whole_run: ratio_whole,
         max_damage: damage.map(|d| d.iter().map(|p| p.wt).fold(0.0, f64::max)),
         max_compressive_damage: damage.map(|d| d.iter().map(|p| p.wc).fold(0.0, f64::max)),
-        cracked_particles: damage.map(|d| d.iter().filter(|p| p.wt >= 0.99).count()),
-        crushed_particles: damage.map(|d| d.iter().filter(|p| p.wc >= 0.99).count()),
+        cracked_particles: damage.map(|d| d.iter().filter(|p| p.cracked()).count()),
+        crushed_particles: damage.map(|d| d.iter().filter(|p| p.crushed()).count()),
         yielded_particles: damage.map(|d| d.iter().filter(|p| p.yielded).count()),
         concrete: crate::model::damage::ConcreteLaw::from_scene(&p.model.scene),
         material_values: p.model.scene.derived.clone(),
@@ -397,15 +404,19 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         bond_damper_implicit_share: p.stable.implicit_share,
         mass_scaling: p.mass_scaling,
         warnings: p
-            .mass_scaling
+            .model
+            .scene
+            .warnings
+            .iter()
+            .cloned()
+            .chain(p.mass_scaling
             .filter(|_| ratio > QUASI_STATIC_LIMIT)
             .map(|m| {
                 format!(
                     "solver.mass_scaling added {:.2}% of the mass and the kinetic energy reached {ratio:.3e} × the elastic energy around the peak, above the quasi-static {QUASI_STATIC_LIMIT}: the added mass may have changed the result; lower solver.mass_scaling or leave it out",
                     100.0 * m.added_mass_fraction
                 )
-            })
-            .into_iter()
+            }))
             .collect(),
         pace: p.model.scene.pace(),
         seed: p.model.scene.effective_seed(),

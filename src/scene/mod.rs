@@ -8,6 +8,7 @@ pub mod concrete;
 mod discretisation;
 mod loading;
 mod overrides;
+mod plausible;
 pub mod random_fields;
 mod resolve;
 mod solver_settings;
@@ -64,6 +65,10 @@ pub struct Scene {
     /// correlation), filled by [`Scene::resolve`]; not read from the file.
     #[serde(skip_deserializing)]
     pub derived: Vec<Derived>,
+    /// Inputs outside the usual range of their quantity, accepted (docs/scenes.md, "Units
+    /// and plausible values"); repeated in the run's summary.json. Not read from the file.
+    #[serde(skip)]
+    pub warnings: Vec<String>,
 }
 
 /// The seed of a scene's random choices when it gives none.
@@ -515,6 +520,7 @@ impl Scene {
         apply_overrides(&mut value, overrides)?;
         let mut scene: Scene = Scene::deserialize(toml::Value::Table(value))
             .map_err(|e| SceneError::Parse(e.to_string()))?;
+        scene.validate_geometry()?;
         scene.resolve()?;
         scene.validate()?;
         Ok(scene)

@@ -47,6 +47,7 @@ impl Scene {
     /// before [`Scene::validate`].
     pub fn resolve(&mut self) -> Result<(), SceneError> {
         self.derived.clear();
+        self.judge_inputs()?;
         let Some(c) = self.concrete.clone() else {
             return self.resolve_elastic();
         };
@@ -223,18 +224,36 @@ impl Scene {
                 "at least -0.8 in a scene with concrete plasticity (the explicit plastic flow diverges as nu approaches -1); or set concrete.plasticity = false",
             ));
         }
+        // blame the key the user wrote: a derived strength follows from f'c
         if s.ft >= s.fc {
-            return Err(invalid(
-                "concrete.ft",
-                s.ft,
-                format!("must be below f'c = {:e} Pa", s.fc),
-            ));
+            return Err(match c.ft {
+                Some(_) => invalid(
+                    "concrete.ft",
+                    s.ft,
+                    format!("must be below f'c = {:e} Pa", s.fc),
+                ),
+                None => invalid(
+                    "concrete.fc",
+                    s.fc,
+                    format!(
+                        "must exceed the tensile strength f't = {:e} Pa it gives",
+                        s.ft
+                    ),
+                ),
+            });
         }
         if s.fy > s.fult {
+            let (key, v) = match (c.fy, c.fult) {
+                (None, Some(fult)) => ("concrete.fult", fult),
+                _ => ("concrete.fy", s.fy),
+            };
             return Err(invalid(
-                "concrete.fy",
-                s.fy,
-                format!("must not exceed f_ult = {:e} Pa", s.fult),
+                key,
+                v,
+                format!(
+                    "f_y = {:e} Pa must not exceed f_ult = {:e} Pa",
+                    s.fy, s.fult
+                ),
             ));
         }
         Ok(())

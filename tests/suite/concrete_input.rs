@@ -135,16 +135,17 @@ fn bad_material_input_is_refused() {
         &["concrete.max_aggregate", "0.02", "Gf0"],
     );
     // G_f so small that COD_c is below the elastic crack opening crack_band·L0·f't/E of
-    // L0 = 10 mm (2.8 × 0.01 m × 2.6164 MPa / 25.13 GPa = 2.915e-6 m; the least G_f is
-    // 2.915e-6 m × f't × (α+γ)/2 = 1.3347 N/m).
+    // L0 = 50 mm (2.8 × 0.05 m × 2.6164 MPa / 25.13 GPa = 1.4576e-5 m; the least G_f is
+    // 1.4576e-5 m × f't × (α+γ)/2 = 6.674 N/m). 5 N/m is below plain concrete's range
+    // but not refused by it (see unit_slips_are_refused_in_the_users_key).
     refused(
-        &["concrete.Gf=0.5"],
+        &["concrete.Gf=5", "discretisation.spacing=0.05"],
         &[
             "concrete.Gf",
-            "0.5000 N/m",
+            "5.0000 N/m",
             "elastic crack opening",
-            "2.915e-6",
-            "1.3347",
+            "1.458e-5",
+            "6.67",
         ],
     );
     // f'c is needed for the correlations
@@ -157,6 +158,52 @@ fn bad_material_input_is_refused() {
     let elastic = format!("{}{}", &text[..start], &text[end..]);
     let e = Scene::from_toml_str(&elastic, &[]).unwrap_err().to_string();
     assert!(e.contains("material.E") && e.contains("missing"), "{e}");
+}
+
+/// A value outside the range real concrete spans is refused in the key the user wrote,
+/// with that range and the unit that would put it inside (docs/scenes.md, "Units and
+/// plausible values"): E = 30 (GPa meant), f'c = 40 (MPa), G_f = 0.08 (N/mm), ρ = 2.4
+/// (t/m³), a spacing of 10 (mm) on a 150 mm wide block. A value inside the hard bounds but
+/// outside plain concrete's range is accepted with a warning.
+#[test]
+fn unit_slips_are_refused_in_the_users_key() {
+    refused(&["material.E=30"], &["material.E = 30", "GPa", "3e10 Pa"]);
+    refused(&["concrete.fc=40"], &["concrete.fc = 40", "MPa", "4e7 Pa"]);
+    refused(
+        &["concrete.Gf=0.08"],
+        &["concrete.Gf = 0.08", "N/mm", "80 N/m"],
+    );
+    refused(
+        &["material.rho=2.4"],
+        &["material.rho = 2.4", "t/m³", "2400 kg/m³"],
+    );
+    refused(
+        &["concrete.ft=2.6"],
+        &["concrete.ft = 2.6", "MPa", "2.6e6 Pa"],
+    );
+    refused(
+        &["discretisation.spacing=10"],
+        &["discretisation.spacing = 10", "mm", "1e-2 m"],
+    );
+    // f'c = 4 looks like ksi (27.6 MPa), not MPa (4 MPa is below the range)
+    refused(&["concrete.fc=4"], &["concrete.fc = 4", "ksi"]);
+    let s = scene(&["concrete.Gf=2000"]).unwrap();
+    assert!(
+        s.warnings.len() == 1 && s.warnings[0].starts_with("concrete.Gf = 2000"),
+        "{:?}",
+        s.warnings
+    );
+    assert!(scene(&[]).unwrap().warnings.is_empty());
+}
+
+/// A strength out of order is blamed on the key the user wrote, not on a derived one.
+#[test]
+fn strengths_out_of_order_blame_the_written_key() {
+    // f_y = (5/6)·f'c = 22.98 MPa is derived; f_ult = 20 MPa is written
+    refused(
+        &["concrete.fult=20e6"],
+        &["concrete.fult = 20000000", "f_y"],
+    );
 }
 
 /// The crack band defaults by discretisation (2D: lattices 2.8, random particles 3.2; 3D: FCC

@@ -20,6 +20,7 @@ mod fuzz_cli;
 mod golden;
 mod layering;
 mod montecarlo;
+mod outputs_agree;
 mod patch_and_newton;
 mod proptest_scenes;
 mod quasi_static;

@@ -647,6 +647,8 @@ external = 0.5
 /// rest): a scene without loads has only round-off energy (1e-23 J here), which the energy
 /// test then compared with itself: K + U = 1.1e-22 J at step 19 was "10× the energy put in".
 /// The test now has a floor at the elastic energy of the position round-off.
+/// (The scene as found had E = 3.0e3 Pa, now refused as no solid; E is written here 1e6
+/// times larger, the same scene in scaled time.)
 #[test]
 fn regression_an_unloaded_specimen_is_not_unstable() {
     let text = r#"
@@ -662,7 +664,7 @@ rotation_deg = -345.97579411574554
 offset = [3.954335343580428e-2, -2.465561050014384e-3]
 surface_correction = true
 [material]
-E = 3.026888536307532e3
+E = 3.026888536307532e9
 nu = -0.99999
 rho = 2.1108511175156312e2
 thickness = 2.1169508356185087e-3
@@ -700,6 +702,8 @@ safety = 0.513402571997595
 /// the total minus the prescribed ones; with every particle driven in x (1e4 J of machine
 /// motion) the free 1e-20 J were lost to cancellation (K came out 0 or negative, and the
 /// check saw round-off of the total as energy). It is now summed over free components only.
+/// (The scene as found had ρ = 7.8e4 kg/m³, now refused for concrete; ρ is written here
+/// 10 times smaller.)
 #[test]
 fn regression_free_kinetic_energy_survives_fast_prescribed_motion() {
     let text = r#"
@@ -714,7 +718,7 @@ offset = [-1.2651098516391587e-1, 4.528153552217843e-2]
 [material]
 E = 2.0000000055268265e10
 nu = 0.45
-rho = 7.824043039283509e4
+rho = 7.824043039283509e3
 thickness = 1.4343778513869598e-2
 plane = "strain"
 [concrete]
@@ -818,6 +822,7 @@ fn regression_a_load_beyond_the_body_is_refused() {
 /// auxetic ν near −1 diverged even at 0.05× the stable step (the explicit plastic flow
 /// overshoots when the shear stiffness E/(2(1+ν)) is many times E). ν < −0.8 with plasticity
 /// is now refused; −0.8 runs, and so does −0.99999 without plasticity.
+/// (The scene as found had ρ = 1.6e4 kg/m³, now refused for concrete; here 2,400.)
 #[test]
 fn regression_auxetic_concrete_plasticity() {
     let text = r#"
@@ -832,7 +837,7 @@ notch_width = 3.160636825308762e-1
 spacing = 1.510717611527332e-1
 [material]
 nu = -0.99999
-rho = 1.6477691510473043e4
+rho = 2.4e3
 thickness = 1e0
 [concrete]
 preset = "splm_block"

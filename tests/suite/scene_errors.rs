@@ -50,7 +50,38 @@ fn error_of_text(text: &str) -> String {
 
 #[test]
 fn base_scene_is_valid() {
-    Scene::from_toml_str(BASE, &[]).unwrap();
+    let s = Scene::from_toml_str(BASE, &[]).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+/// An elastic scene may be of any solid, so only values no solid has are refused (E below
+/// 1e5 Pa), with the likely unit; an unusual one is warned (docs/scenes.md, "Units and
+/// plausible values").
+#[test]
+fn elastic_unit_slips_are_refused_or_warned() {
+    says(
+        &error_of(&["material.E=30"]),
+        &["material.E = 30", "GPa", "3e10 Pa"],
+    );
+    says(
+        &error_of(&["discretisation.spacing=25"]),
+        &[
+            "discretisation.spacing = 25",
+            "at most half",
+            "mm",
+            "2.5e-2 m",
+        ],
+    );
+    // larger than the body but not a slip to mm: no unit is guessed
+    let e = error_of(&["discretisation.spacing=0.2"]);
+    says(&e, &["discretisation.spacing = 0.2", "at most half"]);
+    assert!(!e.contains("mm"), "{e}");
+    let rubber = Scene::from_toml_str(BASE, &["material.E=5e6".to_string()]).unwrap();
+    assert!(
+        rubber.warnings.len() == 1 && rubber.warnings[0].starts_with("material.E = 5000000"),
+        "{:?}",
+        rubber.warnings
+    );
 }
 
 #[test]

@@ -50,11 +50,22 @@ impl Scene {
         }
         let size = self.body_size();
         if d.spacing > 0.5 * size {
+            // a spacing written in mm is 1000 times too large: far larger than the body,
+            // and fine enough once read as mm
+            let hint = if d.spacing > 10.0 * size && d.spacing * 1e-3 <= 0.5 * size {
+                format!(
+                    ": {} looks like a value in mm, which is {:e} m",
+                    d.spacing,
+                    d.spacing * 1e-3
+                )
+            } else {
+                String::new()
+            };
             return Err(invalid(
                 "discretisation.spacing",
                 d.spacing,
                 format!(
-                    "must be at most half the body's smallest dimension ({:.4e} m)",
+                    "the spacing in m must be at most half the body's smallest dimension ({:.4e} m){hint}",
                     0.5 * size
                 ),
             ));

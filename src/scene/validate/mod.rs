@@ -114,17 +114,24 @@ fn simple_polygon(
 impl Scene {
     /// Check every value, table by table; the first problem found is returned.
     pub fn validate(&self) -> Result<(), SceneError> {
-        self.validate_name()?;
-        self.validate_body()?;
-        self.validate_cutouts()?;
+        self.validate_geometry()?;
         super::random_fields::check(self)?;
-        self.validate_discretisation()?;
         self.validate_material()?;
         self.validate_groups()?;
         self.validate_loading()?;
         self.validate_damping()?;
         self.validate_solver()?;
         self.validate_output()
+    }
+
+    /// The name, the body, its cutouts and the discretisation: what the material's
+    /// correlations and checks need to be valid (the spacing against the body), so
+    /// [`Scene::from_toml_str`] runs it before [`Scene::resolve`].
+    pub fn validate_geometry(&self) -> Result<(), SceneError> {
+        self.validate_name()?;
+        self.validate_body()?;
+        self.validate_cutouts()?;
+        self.validate_discretisation()
     }
 
     /// `name` is no group of the scene: the error under `key`, naming the groups there are.
