@@ -2,7 +2,9 @@
 
 use super::convergence::{convergence, ConvergenceArgs};
 use super::crack_path::CRACK_PATH_DAMAGE;
-use super::monte_carlo::{merge, monte_carlo, parse_shard, parse_sizes, MonteCarloArgs};
+use super::monte_carlo::{
+    merge, monte_carlo, parse_shard, parse_sizes, MonteCarloArgs, SIZE_VARIANT_HELP,
+};
 use super::objectivity::{objectivity, ObjectivityArgs, DEFAULT_SEED};
 use super::options::parse_list;
 use super::runner::default_jobs;
@@ -52,12 +54,14 @@ pub enum StudyCommand {
     /// N realisations per size, realisation r of size D with the seed hashed (SplitMix64) from
     /// (S, D in µm, r), plus one deterministic run per size without the random fields. Writes
     /// realisations.csv (a row per finished run; the same command resumes), deterministic.csv
-    /// and, for the whole study, size_effect.csv/json/svg (mean, std and CoV of
-    /// σN = P_max/(0.6·D·t) per size, Bažant type-1 and Weibull fits).
+    /// and, for the whole study, size_effect.csv/json/svg (mean, std and CoV of σN per size,
+    /// Bažant type-1 and Weibull fits).
     ///
-    /// The variant of size D from a scene of size D0 and spacing s0: body.size = D,
-    /// discretisation.spacing = s0·min(1, D/D0), each loaded group's displacement × √(D/D0),
-    /// and with relaxation solver.max_iterations × max(1, D/D0).
+    /// σN per body: a dog-bone P_max/(0.6·D·t); a notched beam (or any beam in three-point
+    /// bending) 3·P_max·S/(2·b·d²), S the span between its supports and D = d its depth; a
+    /// block loaded through whole faces P_max/A over its section normal to the load. Any other
+    /// body is refused.
+    #[command(after_help = SIZE_VARIANT_HELP)]
     Montecarlo {
         scene: PathBuf,
         /// Realisations per size.
@@ -146,6 +150,9 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 progress: !quiet,
             })?;
             crate::say!("{}", report.spread_line());
+            for line in report.crack_summary_lines() {
+                crate::say!("{line}");
+            }
             if let Some(line) = report.angle_effect_line() {
                 crate::say!("{line}");
             }
@@ -208,6 +215,7 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 jobs: jobs.unwrap_or_else(default_jobs),
                 progress: !quiet,
             })?;
+            crate::say!("σN: {}", report.nominal);
             let mut empty = vec![];
             match &report.size_effect {
                 Some(effect) => {

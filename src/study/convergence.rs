@@ -158,6 +158,7 @@ pub fn convergence(args: &ConvergenceArgs) -> anyhow::Result<ConvergenceReport> 
         tag_columns: vec![],
         metric_columns: vec![],
         metrics: &metrics,
+        notes: None,
         inputs: serde_json::json!({
             "study": "convergence",
             "scene_file": args.scene.display().to_string(),

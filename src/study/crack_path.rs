@@ -19,12 +19,72 @@ pub const CRACKED: f64 = 0.99;
 /// Default tensile damage at and above which a particle belongs to the crack path.
 pub const CRACK_PATH_DAMAGE: f64 = 0.9;
 
-fn on_path(x0: &[Vector2<f64>], wt: &[f64], threshold: f64) -> Vec<Vector2<f64>> {
-    x0.iter()
+/// Distance from a support or a loaded group, in particle spacings, within which damage is
+/// not part of the crack path: the crushing and splitting under a support or a loading point
+/// spread over the group's own rows (about two) and a bond length beyond them, and on a beam
+/// those blobs, far apart along the span, would turn the axis of a vertical crack towards the
+/// horizontal.
+pub const CLEARANCE_SPACINGS: f64 = 3.0;
+
+/// The particles to keep the crack path away from: those of the groups with prescribed
+/// displacements (supports, loading points), and the distance (m) to keep.
+#[derive(Clone, Copy, Debug)]
+pub struct Clearance<'a> {
+    pub held: &'a [Vector2<f64>],
+    pub distance: f64,
+}
+
+impl Clearance<'_> {
+    /// No clearance: every damaged particle counts.
+    pub const NONE: Clearance<'static> = Clearance {
+        held: &[],
+        distance: 0.0,
+    };
+
+    fn keeps(&self, x: &Vector2<f64>) -> bool {
+        let d2 = self.distance * self.distance;
+        !self.held.iter().any(|h| (h - x).norm_squared() <= d2)
+    }
+}
+
+/// Why a damage field gives no crack direction.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NoCrack {
+    /// Particles with w_t at or above the threshold.
+    pub damaged: usize,
+    /// How many of them lie within the clearance of a support or a loaded group.
+    pub near_groups: usize,
+    /// Those left for the fit (all of them, or the middle half for the core).
+    pub fitted: usize,
+}
+
+impl std::fmt::Display for NoCrack {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "no crack: {} damaged particles, {} of them next to a support or a loading point, \
+             {} left to fit; a direction needs 2",
+            self.damaged, self.near_groups, self.fitted
+        )
+    }
+}
+
+/// The damaged particles (w_t ≥ `threshold`) away from the held groups, and how many were
+/// damaged in all.
+fn on_path(
+    x0: &[Vector2<f64>],
+    wt: &[f64],
+    threshold: f64,
+    clear: &Clearance,
+) -> (Vec<Vector2<f64>>, usize) {
+    let damaged: Vec<Vector2<f64>> = x0
+        .iter()
         .zip(wt)
         .filter(|(_, &w)| w >= threshold)
         .map(|(x, _)| *x)
-        .collect()
+        .collect();
+    let n = damaged.len();
+    (damaged.into_iter().filter(|x| clear.keeps(x)).collect(), n)
 }
 
 /// The principal line through a set of cracked particles.
@@ -41,11 +101,22 @@ pub struct CrackPath {
 }
 
 /// The crack path of the particles at reference positions `x0` whose tensile damage `wt`
-/// is at least `threshold`; `None` when fewer than two particles are that damaged (no axis).
+/// is at least `threshold`, those within the clearance of a support or a loaded group left
+/// out; [`NoCrack`] when fewer than two remain (no axis).
 /// Principal component analysis of the 2×2 covariance C: the axis angle is
 /// ½·atan2(2·C_xy, C_xx − C_yy) and the RMS distance from it is √λ_min.
-pub fn crack_path(x0: &[Vector2<f64>], wt: &[f64], threshold: f64) -> Option<CrackPath> {
-    principal_line(&on_path(x0, wt, threshold))
+pub fn crack_path(
+    x0: &[Vector2<f64>],
+    wt: &[f64],
+    threshold: f64,
+    clear: &Clearance,
+) -> Result<CrackPath, NoCrack> {
+    let (pts, damaged) = on_path(x0, wt, threshold, clear);
+    principal_line(&pts).ok_or(NoCrack {
+        damaged,
+        near_groups: damaged - pts.len(),
+        fitted: pts.len(),
+    })
 }
 
 /// The principal line of a point set (at least two points).
@@ -87,14 +158,32 @@ pub fn principal_line(pts: &[Vector2<f64>]) -> Option<CrackPath> {
 /// within a quarter of the extent from its midpoint. Damage at the ends of a crack (under the
 /// loading strips of a split cylinder, at the grips) weighs on the axis of the whole set; the
 /// core is the crack itself.
-pub fn crack_core(x0: &[Vector2<f64>], wt: &[f64], threshold: f64) -> Option<CrackPath> {
-    core_line(&on_path(x0, wt, threshold))
+pub fn crack_core(
+    x0: &[Vector2<f64>],
+    wt: &[f64],
+    threshold: f64,
+    clear: &Clearance,
+) -> Result<CrackPath, NoCrack> {
+    let (pts, damaged) = on_path(x0, wt, threshold, clear);
+    core_line(&pts).ok_or(NoCrack {
+        damaged,
+        near_groups: damaged - pts.len(),
+        fitted: core_points(&pts).len(),
+    })
 }
 
 /// The principal line of the points in the middle half of a point set's extent along its
 /// principal axis.
 pub fn core_line(pts: &[Vector2<f64>]) -> Option<CrackPath> {
-    let all = principal_line(pts)?;
+    principal_line(&core_points(pts))
+}
+
+/// The points of a set in the middle half of its extent along its principal axis (none for
+/// fewer than two points).
+fn core_points(pts: &[Vector2<f64>]) -> Vec<Vector2<f64>> {
+    let Some(all) = principal_line(pts) else {
+        return vec![];
+    };
     let (s, c) = all.axis_deg.to_radians().sin_cos();
     let centre = Vector2::new(all.centroid_m[0], all.centroid_m[1]);
     let along = |p: &Vector2<f64>| (p - centre).dot(&Vector2::new(c, s));
@@ -105,12 +194,10 @@ pub fn core_line(pts: &[Vector2<f64>]) -> Option<CrackPath> {
             (l.min(t), h.max(t))
         });
     let (mid, quarter) = (0.5 * (lo + hi), 0.25 * (hi - lo));
-    let middle: Vec<Vector2<f64>> = pts
-        .iter()
+    pts.iter()
         .filter(|p| (along(p) - mid).abs() <= quarter)
         .copied()
-        .collect();
-    principal_line(&middle)
+        .collect()
 }
 
 /// Mean of axes (degrees in [0, 180)): the doubled-angle circular mean, so that the mean of
@@ -181,11 +268,17 @@ mod tests {
             Vector2::new(1.0, 0.0),
             Vector2::new(0.5, 7.0),
         ];
-        let p = crack_path(&x0, &[1.0, 0.995, 0.5], CRACKED).unwrap();
+        let none = &Clearance::NONE;
+        let p = crack_path(&x0, &[1.0, 0.995, 0.5], CRACKED, none).unwrap();
         assert_eq!(p.particles, 2);
         assert!(p.axis_deg.abs() < 1e-12);
-        assert!(crack_path(&x0, &[1.0, 0.2, 0.5], CRACKED).is_none());
-        assert_eq!(crack_path(&x0, &[1.0, 0.2, 0.5], 0.5).unwrap().particles, 2);
+        assert!(crack_path(&x0, &[1.0, 0.2, 0.5], CRACKED, none).is_err());
+        assert_eq!(
+            crack_path(&x0, &[1.0, 0.2, 0.5], 0.5, none)
+                .unwrap()
+                .particles,
+            2
+        );
     }
 
     #[test]
@@ -205,6 +298,94 @@ mod tests {
         assert!(core.rms_width_m < 1e-8, "{core:?} {all:?}");
         // the middle half of the extent (±60 mm along the axis): the 25 points within ±30 mm
         assert_eq!(core.particles, 25, "{core:?}");
+    }
+
+    /// Reference positions, tensile damage, held particles and grid pitch h.
+    type BeamDamage = (Vec<Vector2<f64>>, Vec<f64>, Vec<Vector2<f64>>, f64);
+
+    /// A notched beam's damage field: a square grid of pitch h over 200 × 50 mm, with a blob
+    /// of radius 2.5·h damaged at each support (x = 25 and 175 mm, bottom) and under the load
+    /// (x = 100 mm, top), and a vertical crack two columns wide (x = 100 mm ± h/2, 13 rows from
+    /// the bottom up to 30 mm). The held particles: each group's 3 × 2 grid points about its
+    /// centre.
+    fn beam_damage() -> BeamDamage {
+        let h = 0.0025;
+        let (mut x0, mut wt, mut held) = (vec![], vec![], vec![]);
+        let centres = [
+            Vector2::new(0.025, 0.0),
+            Vector2::new(0.175, 0.0),
+            Vector2::new(0.1, 0.05),
+        ];
+        for i in 0..=80 {
+            for j in 0..=20 {
+                let p = Vector2::new(i as f64 * h, j as f64 * h);
+                let blob = centres.iter().any(|c| (p - c).norm() <= 2.5 * h + 1e-12);
+                x0.push(p);
+                wt.push(if blob { 1.0 } else { 0.1 });
+                if centres
+                    .iter()
+                    .any(|c| (p.x - c.x).abs() <= h + 1e-12 && (p.y - c.y).abs() <= h + 1e-12)
+                {
+                    held.push(p);
+                }
+            }
+        }
+        for j in 0..=12 {
+            for dx in [-0.5 * h, 0.5 * h] {
+                x0.push(Vector2::new(0.1 + dx, j as f64 * h));
+                wt.push(1.0);
+            }
+        }
+        (x0, wt, held, h)
+    }
+
+    /// The damage at the supports turns the axis of the whole set towards the horizontal; kept
+    /// 3 spacings away from the held particles, only the band is left: by symmetry about
+    /// x = 100 mm its axis is 90° (to round-off) and its RMS width h/2.
+    #[test]
+    fn damage_at_supports_and_loading_points_leaves_the_crack_axis() {
+        let (x0, wt, held, h) = beam_damage();
+        let all = crack_path(&x0, &wt, CRACK_PATH_DAMAGE, &Clearance::NONE).unwrap();
+        assert!(axis_difference_deg(all.axis_deg, 90.0) > 45.0, "{all:?}");
+        let clear = Clearance {
+            held: &held,
+            distance: CLEARANCE_SPACINGS * h,
+        };
+        let p = crack_path(&x0, &wt, CRACK_PATH_DAMAGE, &clear).unwrap();
+        assert!(axis_difference_deg(p.axis_deg, 90.0) < 1e-9, "{p:?}");
+        assert_eq!(p.particles, 2 * 13, "the band's two columns of 13 rows");
+        assert!((p.rms_width_m - 0.5 * h).abs() < 1e-12, "{p:?}");
+        assert!((p.centroid_m[0] - 0.1).abs() < 1e-12, "{p:?}");
+        let core = crack_core(&x0, &wt, CRACK_PATH_DAMAGE, &clear).unwrap();
+        assert!(axis_difference_deg(core.axis_deg, 90.0) < 1e-9, "{core:?}");
+    }
+
+    /// No damaged particle, one, or only particles next to the groups: an explicit "no crack"
+    /// with the counts, never an axis of NaN.
+    #[test]
+    fn too_few_damaged_particles_give_no_crack_not_nan() {
+        let x0 = vec![Vector2::new(0.0, 0.0), Vector2::new(0.01, 0.0)];
+        let none = &Clearance::NONE;
+        for wt in [[0.0, 0.0], [1.0, 0.0]] {
+            let e = crack_path(&x0, &wt, CRACK_PATH_DAMAGE, none).unwrap_err();
+            assert_eq!(e.fitted, wt.iter().filter(|w| **w >= 0.9).count());
+            let text = e.to_string();
+            assert!(
+                text.starts_with("no crack") && !text.contains("NaN"),
+                "{text}"
+            );
+            assert!(crack_core(&x0, &wt, CRACK_PATH_DAMAGE, none).is_err());
+        }
+        // two particles: a path, but the middle half of its extent holds none
+        let core = crack_core(&x0, &[1.0, 1.0], CRACK_PATH_DAMAGE, none).unwrap_err();
+        assert_eq!((core.damaged, core.fitted), (2, 0));
+        let held = [Vector2::new(0.0, 0.001)];
+        let clear = Clearance {
+            held: &held,
+            distance: 0.005,
+        };
+        let e = crack_path(&x0, &[1.0, 1.0], CRACK_PATH_DAMAGE, &clear).unwrap_err();
+        assert_eq!((e.damaged, e.near_groups, e.fitted), (2, 1, 1));
     }
 
     #[test]

@@ -22,12 +22,15 @@
 //! are those of a plane's crack and stay empty in 3D; the crack counts are filled.
 
 use super::angle_effect::{angle_effect, AngleEffect};
-use super::crack_path::{crack_core, crack_path, mean_axis_deg};
+use super::crack_path::{
+    crack_core, crack_path, mean_axis_deg, Clearance, CrackPath, NoCrack, CLEARANCE_SPACINGS,
+};
 use super::runner::{RunResult, Study, Variant};
 use crate::random_field::splitmix64;
 use crate::run::Outcome;
 use crate::Scene;
 use anyhow::bail;
+use nalgebra::Vector2;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -108,31 +111,74 @@ pub const CRACK_COLUMNS: [&str; 10] = [
     "crack_core_centroid_y_m",
 ];
 
+/// The in-plane reference positions of the particles of the groups with prescribed
+/// displacements: the supports (fixed components) and the loaded groups.
+fn held_points(o: &Outcome) -> Vec<Vector2<f64>> {
+    let held: Vec<&str> = o
+        .scene
+        .groups
+        .iter()
+        .filter(|g| !g.fix.is_empty() || g.load.is_some())
+        .map(|g| g.name.as_str())
+        .collect();
+    o.groups
+        .iter()
+        .filter(|g| held.contains(&g.name.as_str()))
+        .flat_map(|g| g.members.iter().map(|&i| o.point2(i as usize)))
+        .collect()
+}
+
+/// The crack path and its core of a 2D run with damage, the particles within
+/// [`CLEARANCE_SPACINGS`] spacings of a support or a loaded group left out; `None` in 3D or
+/// without damage.
+fn crack_lines(o: &Outcome, threshold: f64) -> Option<[Result<CrackPath, NoCrack>; 2]> {
+    let d = o.damage.as_ref()?;
+    if o.dim == 3 {
+        return None;
+    }
+    let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
+    let held = held_points(o);
+    let clear = Clearance {
+        held: &held,
+        distance: CLEARANCE_SPACINGS * o.scene.discretisation.spacing,
+    };
+    Some([
+        crack_path(&x0, &wt, threshold, &clear),
+        crack_core(&x0, &wt, threshold, &clear),
+    ])
+}
+
 /// The crack-path columns of a run: the principal line of all cracked particles and of the
-/// crack's core ([`super::crack_path`]); NaN where fewer than two particles cracked.
+/// crack's core ([`super::crack_path`]) away from the supports and loaded groups; NaN (an
+/// empty cell) where fewer than two particles are left to fit, and in 3D.
 fn crack_metrics(o: &Outcome, threshold: f64) -> Vec<f64> {
     let Some(d) = &o.damage else {
         return [vec![0.0, 0.0], vec![f64::NAN; CRACK_COLUMNS.len() - 2]].concat();
     };
-    let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
-    let count = |t: f64| wt.iter().filter(|w| **w >= t).count() as f64;
+    let count = |t: f64| d.iter().filter(|p| p.wt >= t).count() as f64;
     let mut v = vec![count(super::crack_path::CRACKED), count(threshold)];
-    // the crack path in the plane of a 2D run
-    if o.dim == 3 {
+    let Some(lines) = crack_lines(o, threshold) else {
         v.extend([f64::NAN; 8]);
         return v;
-    }
-    let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
-    for line in [
-        crack_path(&x0, &wt, threshold),
-        crack_core(&x0, &wt, threshold),
-    ] {
+    };
+    for line in lines {
         match line {
-            Some(p) => v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]]),
-            None => v.extend([f64::NAN; 4]),
+            Ok(p) => v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]]),
+            Err(_) => v.extend([f64::NAN; 4]),
         }
     }
     v
+}
+
+/// Why a 2D run's crack path or core has no axis ([`NoCrack`]), for the run's message.
+fn crack_note(o: &Outcome, threshold: f64) -> Option<String> {
+    let [path, core] = crack_lines(o, threshold)?;
+    match (path, core) {
+        (Err(e), _) => Some(format!("crack path: {e}")),
+        (Ok(_), Err(e)) => Some(format!("crack core: {e}")),
+        _ => None,
+    }
 }
 
 /// A value at its extreme among the runs.
@@ -202,6 +248,10 @@ pub struct AngleSummary {
     pub mean_crack_axis_deg: Option<f64>,
     pub mean_crack_centroid_x_m: Option<f64>,
     pub mean_crack_core_axis_deg: Option<f64>,
+    /// Why `mean_crack_axis_deg` is null: no run at this angle left two damaged particles
+    /// away from the supports and loaded groups (their messages say how many there were),
+    /// or none completed.
+    pub crack_note: Option<String>,
 }
 
 /// objectivity.json.
@@ -246,6 +296,24 @@ impl ObjectivityReport {
             100.0 * e.expected_spread_without_angle_effect,
             e.p_value
         ))
+    }
+
+    /// One line per angle: the mean crack axis and that of the core, or why there is none.
+    pub fn crack_summary_lines(&self) -> Vec<String> {
+        let deg = |a: Option<f64>| a.map_or("none".to_string(), |a| format!("{a:.1}°"));
+        self.per_angle
+            .iter()
+            .map(|a| match &a.crack_note {
+                Some(note) => format!("θ = {}°: {note}", a.angle_deg),
+                None => format!(
+                    "θ = {}°: crack axis {} (core {}) over {} runs, away from the supports and loading points",
+                    a.angle_deg,
+                    deg(a.mean_crack_axis_deg),
+                    deg(a.mean_crack_core_axis_deg),
+                    a.runs
+                ),
+            })
+            .collect()
     }
 
     /// The one line the CLI prints.
@@ -297,6 +365,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
     let make = variants(args, &base, three, axis);
     let threshold = args.crack_damage;
     let metrics = move |o: &Outcome| crack_metrics(o, threshold);
+    let notes = move |o: &Outcome| crack_note(o, threshold);
     let study = Study {
         scene: args.scene.clone(),
         base_overrides: args.overrides.clone(),
@@ -305,6 +374,7 @@ pub fn objectivity(args: &ObjectivityArgs) -> anyhow::Result<ObjectivityReport> 
         tag_columns: vec!["angle_deg".into(), "offset".into(), "seed".into()],
         metric_columns: CRACK_COLUMNS.iter().map(|s| s.to_string()).collect(),
         metrics: &metrics,
+        notes: Some(&notes),
         inputs: serde_json::json!({
             "study": "objectivity",
             "scene_file": args.scene.display().to_string(),
@@ -555,8 +625,31 @@ fn per_angle(angles: &[f64], by_angle: &[Vec<&RunResult>]) -> Vec<AngleSummary> 
                 rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
             ),
             mean_crack_core_axis_deg: axis_of(rs, "crack_core_axis_deg"),
+            crack_note: crack_note_of(rs, axis_of(rs, "crack_axis_deg").is_some(), |r| {
+                metric(r, "crack_axis_deg")
+            }),
         })
         .collect()
+}
+
+/// [`AngleSummary::crack_note`] of the completed runs `rs` of an angle.
+fn crack_note_of(
+    rs: &[&RunResult],
+    has_mean: bool,
+    axis: impl Fn(&RunResult) -> f64,
+) -> Option<String> {
+    let measured = rs.iter().filter(|r| axis(r).is_finite()).count();
+    match (has_mean, rs.len(), measured) {
+        (true, _, _) => None,
+        (false, 0, _) => Some("no crack: no run completed at this angle".into()),
+        (false, n, 0) => Some(format!(
+            "no crack in the {n} completed runs: fewer than 2 damaged particles away from the \
+             supports and loading points, or a 3D run"
+        )),
+        (false, _, m) => Some(format!(
+            "the crack axes of the {m} runs with a crack cancel: no mean direction"
+        )),
+    }
 }
 
 #[cfg(test)]

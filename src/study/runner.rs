@@ -67,6 +67,9 @@ pub struct Variant {
 /// Numbers a study derives from a finished run, beyond the summary (one per metric column).
 pub type Metrics = dyn Fn(&Outcome) -> Vec<f64> + Sync;
 
+/// A note on a run's metrics ([`Study::notes`]).
+pub type Notes = dyn Fn(&Outcome) -> Option<String> + Sync;
+
 /// A study: where it lives, its CSV layout and how its runs are made.
 pub struct Study<'a> {
     /// The scene file.
@@ -82,6 +85,8 @@ pub struct Study<'a> {
     /// Columns after the summary columns that `metrics` fills.
     pub metric_columns: Vec<String>,
     pub metrics: &'a Metrics,
+    /// A note on a completed run's metrics (why one is not measured), added to its message.
+    pub notes: Option<&'a Notes>,
     /// What must be the same for rows already in the folder to be reused (the scene,
     /// the base overrides, a seed): written to `dir/study_inputs.json` and compared on resume.
     pub inputs: serde_json::Value,
@@ -184,7 +189,14 @@ impl Study<'_> {
             r.total_time_s.to_string(),
             r.status.clone(),
         ]);
-        v.extend(r.metrics.iter().map(|m| m.to_string()));
+        // a metric not measured (NaN: no crack to fit, no σN) is an empty cell
+        v.extend(r.metrics.iter().map(|m| {
+            if m.is_nan() {
+                String::new()
+            } else {
+                m.to_string()
+            }
+        }));
         v.push(r.message.clone());
         v
     }
@@ -252,7 +264,10 @@ impl Study<'_> {
                 total_time_s: num(b + 9)?,
                 status: rec[b + 10].to_string(),
                 metrics: (0..nm)
-                    .map(|i| num(b + 11 + i))
+                    .map(|i| match rec[b + 11 + i].is_empty() {
+                        true => Ok(f64::NAN),
+                        false => num(b + 11 + i),
+                    })
                     .collect::<anyhow::Result<_>>()?,
                 message: rec[b + 11 + nm].to_string(),
             });
@@ -357,6 +372,12 @@ impl Study<'_> {
                     row.metrics.len(),
                     self.metric_columns.len()
                 );
+                if let Some(note) = self.notes.and_then(|n| n(&outcome)) {
+                    row.message = match row.message.is_empty() {
+                        true => note,
+                        false => format!("{}; {note}", row.message),
+                    };
+                }
             }
             Err(e) => row.message = e.to_string(),
         }

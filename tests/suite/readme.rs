@@ -138,3 +138,44 @@ fn set_changes_one_value_without_editing_the_file() {
     );
     assert_eq!(std::fs::read_to_string(root().join(scene)).unwrap(), before);
 }
+
+/// The size variant's rule is one text in the code (`SPACING_RULE`, its displacement part
+/// `DISPLACEMENT_RULE`), and the code applies it: dog-bone D (D0 = 0.4 m, 0.5 mm) at
+/// D = 1.6 m is pulled 0.5 mm × √4 = 1 mm. The README, docs/studies.md and `sppm study
+/// montecarlo --help` state that rule in those words, and none says the displacement scales
+/// as D/D0.
+#[test]
+fn the_size_variant_rule_is_stated_as_the_code_applies_it() {
+    use sppm::study::monte_carlo::{size_overrides, DISPLACEMENT_RULE, SPACING_RULE};
+    let base = sppm::Scene::from_file(&root().join("lattices/dogbone_D.toml"), &[]).unwrap();
+    let o = size_overrides(&base, 1.6);
+    let delta: f64 = o[2]
+        .strip_prefix("groups.2.load.displacement=")
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((delta - 0.5e-3 * 4f64.sqrt()).abs() < 1e-15, "{o:?}");
+    assert!(DISPLACEMENT_RULE.contains("√(D/D0)") && SPACING_RULE.contains(DISPLACEMENT_RULE));
+    let words = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
+    let docs = words(&std::fs::read_to_string(root().join("docs/studies.md")).unwrap());
+    let help = words(&stdout(&sppm(&["study", "montecarlo", "--help"])));
+    let readme = words(&readme());
+    assert!(docs.contains(SPACING_RULE), "docs/studies.md");
+    assert!(help.contains(SPACING_RULE), "--help: {help}");
+    assert!(readme.contains(DISPLACEMENT_RULE), "README.md");
+    for (name, text) in [
+        ("README.md", &readme),
+        ("docs/studies.md", &docs),
+        ("--help", &help),
+    ] {
+        for wrong in [
+            "displacement × D/D0",
+            "displacement multiplied by D/D0",
+            "displacement scaled by D/D0",
+            "displacement *= D/D0",
+            "displacement proportional to D",
+        ] {
+            assert!(!text.contains(wrong), "{name} says `{wrong}`");
+        }
+    }
+}

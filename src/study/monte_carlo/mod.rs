@@ -37,14 +37,17 @@
 //!   folders into the same files.
 
 mod merge;
+mod nominal;
 mod records;
 mod shards;
 mod sizes;
 
 pub use merge::{merge, MergeReport};
+pub use nominal::{body_kind, three_point_span, Nominal};
 pub use shards::{parse_shard, Item, Shard, ShardRuns};
 pub use sizes::{
-    nominal_strength, parse_sizes, realisation_seed, size_overrides, DOGBONE_SIZES, SPACING_RULE,
+    nominal_strength, parse_sizes, realisation_seed, size_overrides, DISPLACEMENT_RULE,
+    DOGBONE_SIZES, SIZE_VARIANT_HELP, SPACING_RULE,
 };
 
 use super::runner::{RunOutputs, RunResult, Runs, Study, Variant};
@@ -84,8 +87,9 @@ const TAGS: [&str; 3] = ["size_D_m", "realisation", "seed"];
 const DET_TAGS: [&str; 2] = ["size_D_m", "seed"];
 const METRICS: [&str; 1] = ["sigma_N_Pa"];
 
+/// σN of a run (NaN where it is not defined: the study refuses such a scene before it runs).
 fn sigma_metric(o: &Outcome) -> Vec<f64> {
-    vec![nominal_strength(&o.scene, o.summary.peak_force_n)]
+    vec![nominal_strength(&o.scene, o.summary.peak_force_n).unwrap_or(f64::NAN)]
 }
 
 /// The two study tables of a folder: realisations and deterministic runs.
@@ -107,6 +111,7 @@ fn studies<'a>(
         tag_columns: tags.iter().map(|s| s.to_string()).collect(),
         metric_columns: METRICS.iter().map(|s| s.to_string()).collect(),
         metrics: &sigma_metric,
+        notes: None,
         inputs: inputs.clone(),
         jobs,
         progress,
@@ -125,6 +130,8 @@ pub struct MonteCarloReport {
     /// Runs (realisations and deterministic) that completed.
     pub completed: usize,
     pub size_effect: Option<SizeEffect>,
+    /// How σN was read ([`Nominal::describe`]).
+    pub nominal: String,
 }
 
 /// Run the study (or one shard of it); without a shard, write the size-effect report.
@@ -133,6 +140,7 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
         bail!("--realisations 0: at least 1 realisation per size is needed");
     }
     let base = Scene::from_file(&args.scene, &args.overrides)?;
+    let nominal = Nominal::of(&base)?;
     check_random_fields(args, &base)?;
     let sizes = study_sizes(args, &base)?;
     let dir = args
@@ -141,7 +149,7 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
         .unwrap_or_else(|| PathBuf::from("output").join(format!("{}-montecarlo", base.name())));
     let text = std::fs::read(&args.scene)
         .with_context(|| format!("cannot read {}", args.scene.display()))?;
-    let d0 = nominal_size(&base).0;
+    let d0 = nominal.size();
     let inputs = StudyInputs::of(args, &base, &sizes, &text, d0);
     let outputs = if args.keep_outputs {
         RunOutputs::All
@@ -222,6 +230,7 @@ pub fn monte_carlo(args: &MonteCarloArgs) -> anyhow::Result<MonteCarloReport> {
         runs,
         completed,
         size_effect,
+        nominal: nominal.describe(),
     })
 }
 
@@ -252,12 +261,12 @@ fn check_random_fields(args: &MonteCarloArgs, base: &Scene) -> anyhow::Result<()
 /// own size.
 fn study_sizes(args: &MonteCarloArgs, base: &Scene) -> anyhow::Result<Vec<f64>> {
     let Some(s) = &args.sizes else {
-        return Ok(vec![nominal_size(base).0]);
+        return Ok(vec![nominal_size(base)?]);
     };
     if dogbone_size(&base.body).is_none() {
         bail!(
-            "--sizes needs a dog-bone body ([body] shape = \"dogbone\", or a prism of a dog-bone section); the scene's body is `{}` (leave --sizes out to run the scene's own size)",
-            base.body.name()
+            "--sizes needs a dog-bone body ([body] shape = \"dogbone\", or a prism of a dog-bone section); the scene's body is `{}`, whose supports and loading points are groups at fixed positions that a size variant would not move (leave --sizes out to run the scene's own size)",
+            body_kind(&base.body)
         );
     }
     if !base.cutouts.is_empty() {
@@ -342,7 +351,8 @@ fn size_effect(
         "seed": args.seed,
         "realisations": args.realisations,
         "spacing_rule": SPACING_RULE,
-        "scene_size_m": nominal_size(base).0,
+        "scene_size_m": nominal_size(base)?,
+        "nominal_stress": Nominal::of(base)?.describe(),
         "scene_spacing_m": base.discretisation.spacing,
         "overrides": args.overrides,
     });

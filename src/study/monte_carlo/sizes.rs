@@ -2,6 +2,7 @@
 //! ([`SPACING_RULE`]), the seed of a realisation of a size, and the nominal strength σN of
 //! a run.
 
+use super::nominal::Nominal;
 use crate::random_field::splitmix64;
 use crate::scene::BodySpec;
 use crate::study::size_effect_report::size_um;
@@ -18,10 +19,28 @@ pub const DOGBONE_SIZES: [(char, f64); 6] = [
     ('F', 1.6),
 ];
 
+/// The scaling rule of the size variant, the one text the documentation, `--help` and
+/// size_effect.json state it in.
+macro_rules! spacing_rule {
+    () => {
+        "body.size = D; discretisation.spacing = s0·min(1, D/D0); every loaded group's \
+         displacement × √(D/D0); with the relaxation solver, solver.max_iterations × \
+         max(1, D/D0) (D0, s0: the scene's size and spacing)"
+    };
+}
+
 /// The rule that makes a size variant, as recorded in size_effect.json.
-pub const SPACING_RULE: &str = "body.size = D; discretisation.spacing = s0*min(1, D/D0); \
-     each loaded group's displacement *= sqrt(D/D0); relaxation: solver.max_iterations *= \
-     max(1, D/D0) (D0, s0: the scene's size and spacing)";
+pub const SPACING_RULE: &str = spacing_rule!();
+
+/// How the loaded groups' displacement scales with the size: a part of [`SPACING_RULE`].
+pub const DISPLACEMENT_RULE: &str = "every loaded group's displacement × √(D/D0)";
+
+/// The paragraph of `sppm study montecarlo --help` that states [`SPACING_RULE`].
+pub const SIZE_VARIANT_HELP: &str = concat!(
+    "Size variant of size D from a scene of size D0 and spacing s0 (--sizes, dog-bones only): ",
+    spacing_rule!(),
+    "."
+);
 
 /// Read `--sizes`: dog-bone letters A–F or sizes D in m (> 0), comma-separated; returned
 /// sorted and without repeats.
@@ -57,28 +76,10 @@ pub fn realisation_seed(study_seed: u64, d: f64, r: usize) -> u64 {
     splitmix64(splitmix64(splitmix64(study_seed) ^ size_um(d)) ^ r as u64) >> 1
 }
 
-/// The nominal strength σN = P_max/(b·D·t) of a run of `scene`: b = 0.6 and D the size of a
-/// dog-bone (σN is then the mean stress over the neck; in 3D t is the prism's thickness),
-/// else b = 1 and D the body's width. Other 3D bodies: σN = P_max/A with A = V/ℓ, the body's
-/// mean section normal to the loaded component (ℓ its extent along it; a box's or a
-/// prism's section when pulled along its length).
-pub fn nominal_strength(scene: &Scene, peak_force_n: f64) -> f64 {
-    let (d, b) = nominal_size(scene);
-    match (&scene.body, scene.solid()) {
-        (BodySpec::Prism { thickness, .. }, _) if dogbone_size(&scene.body).is_some() => {
-            peak_force_n.abs() / (b * d * thickness)
-        }
-        (_, Some(solid)) => {
-            let k = scene
-                .groups
-                .iter()
-                .find_map(|g| g.load.as_ref())
-                .map_or(2, |l| l.component.index());
-            let (lo, hi) = solid.bounding_box();
-            peak_force_n.abs() * (hi[k] - lo[k]) / solid.volume()
-        }
-        _ => peak_force_n.abs() / (b * d * scene.material.thickness()),
-    }
+/// The nominal strength σN (Pa) of a run of `scene` with peak force `peak_force_n`, defined
+/// per body ([`Nominal`]); an error naming the body when σN is not defined for it.
+pub fn nominal_strength(scene: &Scene, peak_force_n: f64) -> anyhow::Result<f64> {
+    Ok(Nominal::of(scene)?.strength(peak_force_n))
 }
 
 /// The size D of a dog-bone body: the 2D dog-bone or a prism of its section.
@@ -90,15 +91,9 @@ pub(super) fn dogbone_size(body: &BodySpec) -> Option<f64> {
     }
 }
 
-/// (D, b) of [`nominal_strength`].
-pub(super) fn nominal_size(scene: &Scene) -> (f64, f64) {
-    match dogbone_size(&scene.body) {
-        Some(size) => (size, 0.6),
-        None => {
-            let (lo, hi) = scene.shape().bounding_box();
-            (hi.x - lo.x, 1.0)
-        }
-    }
+/// The size D (m) of `scene` in the size effect ([`Nominal::size`]).
+pub(super) fn nominal_size(scene: &Scene) -> anyhow::Result<f64> {
+    Ok(Nominal::of(scene)?.size())
 }
 
 /// The label of a size: D in mm, e.g. `D50mm`.
@@ -195,7 +190,7 @@ mod tests {
         assert_eq!(o.len(), 3, "explicit: max_iterations is not set");
         let s = Scene::from_file(Path::new("lattices/dogbone_D.toml"), &o).unwrap();
         assert!(matches!(s.body, BodySpec::Dogbone { size } if size == 1.6));
-        let sigma = nominal_strength(&s, 1.0e5);
+        let sigma = nominal_strength(&s, 1.0e5).unwrap();
         assert!((sigma - 1.0e5 / (0.6 * 1.6 * 0.1)).abs() < 1e-6);
         let relax = Scene::from_file(Path::new("lattices/dogbone_montecarlo.toml"), &[]).unwrap();
         let o = size_overrides(&relax, 1.6);
@@ -217,10 +212,10 @@ mod tests {
         );
         let s = Scene::from_file(Path::new("lattices/dogbone_B_3d.toml"), &o).unwrap();
         assert_eq!(dogbone_size(&s.body), Some(0.2));
-        let sigma = nominal_strength(&s, 1.0e5);
+        let sigma = nominal_strength(&s, 1.0e5).unwrap();
         assert!((sigma / (1.0e5 / (0.6 * 0.2 * 0.1)) - 1.0).abs() < 1e-12);
         let prism = Scene::from_file(Path::new("lattices/tension_prism_3d.toml"), &[]).unwrap();
-        let sigma = nominal_strength(&prism, 1.0e5);
+        let sigma = nominal_strength(&prism, 1.0e5).unwrap();
         assert!((sigma / (1.0e5 / (0.15 * 0.15)) - 1.0).abs() < 1e-12);
     }
 }
