@@ -105,7 +105,7 @@ fn pick<const D: usize>(x0: &[SVector<f64, D>], f: &dyn Fn(&SVector<f64, D>) -> 
 }
 
 /// The one particle nearest `q` (none in an empty body).
-fn nearest<const D: usize>(x0: &[SVector<f64, D>], q: &SVector<f64, D>) -> Vec<u32> {
+pub fn nearest<const D: usize>(x0: &[SVector<f64, D>], q: &SVector<f64, D>) -> Vec<u32> {
     (0..x0.len())
         .min_by(|&a, &b| {
             (x0[a] - q)
@@ -114,6 +114,21 @@ fn nearest<const D: usize>(x0: &[SVector<f64, D>], q: &SVector<f64, D>) -> Vec<u
         })
         .map(|i| vec![i as u32])
         .unwrap_or_default()
+}
+
+/// The middle of a strip along its edge's tangent `t`: the scene's `centre`, else the
+/// middle of the shape's extent along `t`.
+pub fn strip_centre(centre: Option<f64>, t: Vector2<f64>, shape: &Shape2) -> f64 {
+    centre.unwrap_or_else(|| {
+        let (lo, hi) = shape.bounding_box();
+        0.5 * (lo + hi).dot(&t)
+    })
+}
+
+/// The middle of a strip on `edge` of `shape` (see [`strip_centre`]); `None` for the faces
+/// normal to z.
+pub fn strip_centre_on(centre: Option<f64>, edge: Edge, shape: &Shape2) -> Option<f64> {
+    edge_frame(edge).map(|(_, t)| strip_centre(centre, t, shape))
 }
 
 /// Select the members of a group. Empty selections are reported by the caller.
@@ -167,6 +182,7 @@ pub fn select<const K: usize>(sel: &Selection, p: &Particles<2, K>, shape: &Shap
             };
             let half = 0.5 * width + eps;
             let depth = depth.unwrap_or(2.0 * pitch);
+            let centre = strip_centre(*centre, t, shape);
             pick(&|x| {
                 let s = x.dot(&t);
                 (s - centre).abs() <= half
@@ -228,6 +244,7 @@ pub fn select_3d<const K: usize>(
             };
             let half = 0.5 * width + eps;
             let depth = depth.unwrap_or(2.0 * pitch);
+            let centre = strip_centre(*centre, t, section);
             pick(&|x| {
                 let q = Vector2::new(x.x, x.y);
                 let s = q.dot(&t);
@@ -348,7 +365,7 @@ mod tests {
             &Selection::Strip {
                 edge: Edge::Top,
                 width: 0.02,
-                centre: 0.0,
+                centre: Some(0.0),
                 depth: None,
             },
             &p,

@@ -16,12 +16,16 @@ pub const COLUMNS: [&str; 8] = [
     "damping_J",
 ];
 
-pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
+/// The records, one row each: [`COLUMNS`], then a column `gauge_<name>_m` per gauge of
+/// `gauges` (their names, in the scene's order).
+pub fn write_records(records: &[Record], gauges: &[&str], path: &Path) -> anyhow::Result<()> {
     let mut w = ::csv::Writer::from_path(path)
         .with_context(|| format!("cannot write {}", path.display()))?;
-    w.write_record(COLUMNS)?;
+    let mut head: Vec<String> = COLUMNS.iter().map(|c| c.to_string()).collect();
+    head.extend(gauges.iter().map(|g| format!("gauge_{g}_m")));
+    w.write_record(&head)?;
     for r in records {
-        w.write_record([
+        let mut row = vec![
             r.step.to_string(),
             format!("{:e}", r.time_s),
             format!("{:e}", r.displacement_m),
@@ -30,7 +34,9 @@ pub fn write_records(records: &[Record], path: &Path) -> anyhow::Result<()> {
             format!("{:e}", r.internal_j),
             format!("{:e}", r.external_work_j),
             format!("{:e}", r.damping_j),
-        ])?;
+        ];
+        row.extend(r.gauges[..gauges.len()].iter().map(|g| format!("{g:e}")));
+        w.write_record(&row)?;
     }
     w.flush()?;
     Ok(())

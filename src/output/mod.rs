@@ -1,6 +1,7 @@
 //! Reports of a run (docs/architecture.md, "Interfaces"): summary.json, force_displacement.csv,
 //! increments.csv (relaxation and quasi-static runs), particles.csv,
-//! force_displacement.svg, crack_map.svg (scenes with damage), random_field_<property>.svg (each
+//! force_displacement.svg, force_gauge_<name>.svg (each gauge), crack_map.svg (scenes with
+//! damage), random_field_<property>.svg (each
 //! random field, with the crack on top), particle_map.svg and particles.vtk in the run's folder.
 
 pub mod csv;
@@ -13,7 +14,8 @@ use crate::fsio;
 use crate::run::Outcome;
 use std::path::{Path, PathBuf};
 
-/// The files of a run that sppm owns in its folder (besides `random_field_<property>.svg`):
+/// The files of a run that sppm owns in its folder (besides `random_field_<property>.svg`
+/// and `force_gauge_<name>.svg`):
 /// a new run into the folder replaces them all, so the folder only ever holds one run.
 pub const RUN_FILES: [&str; 8] = [
     "summary.json",
@@ -28,7 +30,9 @@ pub const RUN_FILES: [&str; 8] = [
 
 /// Is `name` a file that a run writes into its folder?
 pub fn is_run_file(name: &str) -> bool {
-    RUN_FILES.contains(&name) || (name.starts_with("random_field_") && name.ends_with(".svg"))
+    RUN_FILES.contains(&name)
+        || (name.starts_with("random_field_") && name.ends_with(".svg"))
+        || (name.starts_with("force_gauge_") && name.ends_with(".svg"))
 }
 
 /// Write every output the scene asks for into `dir`; returns the files written.
@@ -54,8 +58,14 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
             files.push(f);
             Ok(())
         };
+    let gauges: Vec<&str> = outcome
+        .scene
+        .gauges
+        .iter()
+        .map(|g| g.name.as_str())
+        .collect();
     put("force_displacement.csv".into(), &|f| {
-        csv::write_records(&outcome.records, f)
+        csv::write_records(&outcome.records, &gauges, f)
     })?;
     if !outcome.increments.is_empty() {
         put("increments.csv".into(), &|f| {
@@ -68,6 +78,11 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
     put("force_displacement.svg".into(), &|f| {
         plots::force_displacement(outcome, f)
     })?;
+    for (k, g) in gauges.iter().enumerate() {
+        put(format!("force_gauge_{g}.svg"), &|f| {
+            plots::force_gauge(outcome, k, f)
+        })?;
+    }
     let o = &outcome.scene.output;
     // a 3D run's maps draw its section (output::section)
     let view = (outcome.dim == 3).then(|| section::section_view(outcome));

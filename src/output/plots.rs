@@ -138,6 +138,52 @@ pub fn force_displacement(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// force_gauge_<name>.svg: the probe group's reaction (kN, with the sign of
+/// force_displacement.svg) against the opening of gauge `k` (mm), the peak marked.
+pub fn force_gauge(o: &Outcome, k: usize, path: &Path) -> anyhow::Result<()> {
+    let sign = if o.summary.sign_turned { -1.0 } else { 1.0 };
+    let pts: Vec<(f64, f64)> = o
+        .records
+        .iter()
+        .map(|r| (r.gauges[k] * 1e3, sign * r.force_n * 1e-3))
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for &(x, y) in &pts {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    let name = &o.scene.gauges[k].name;
+    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let mut chart = force_displacement_axes(
+        &root,
+        &format!("{}: force against gauge '{name}'", o.summary.scene),
+        (padded(x0, x1), padded(y0, y1)),
+        &format!("opening of gauge '{name}'"),
+        false,
+    )?;
+    chart
+        .draw_series(LineSeries::new(pts.iter().copied(), BLUE.stroke_width(2)))
+        .map_err(err)?;
+    if let Some(g) = o.summary.gauges.get(k) {
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (g.at_peak_m * 1e3, o.summary.peak_force_n * 1e-3),
+                5,
+                RED.filled(),
+            )))
+            .map_err(err)?
+            .label(format!(
+                "peak {:.4} kN at {:.4} mm",
+                o.summary.peak_force_n * 1e-3,
+                g.at_peak_m * 1e3
+            ))
+            .legend(|(x, y)| Circle::new((x, y), 5, RED.filled()));
+        draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
+
 /// The particle drawing shared by the particle and crack maps: positions x0 + scale·u in mm,
 /// the bounds with a margin of one spacing, a plot area sized to the body's aspect ratio
 /// and the disc radius that makes neighbouring particles touch.

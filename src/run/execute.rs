@@ -138,12 +138,14 @@ pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> 
         ramp: p.model.scene.loading.ramp,
         t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
     };
-    Simulation::new(
+    let mut sim = Simulation::new(
         p.model.particles.x0.clone(),
         std::mem::take(&mut p.model.mech),
         std::mem::take(&mut p.model.prescribed),
         integration,
-    )
+    );
+    sim.gauges = super::gauges::gauges_of(&p.model);
+    sim
 }
 
 /// The settings of a relaxation or quasi-static run: the scene's increments and tolerances,

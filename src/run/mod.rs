@@ -14,6 +14,7 @@
 pub mod check;
 pub mod dispatch;
 pub mod execute;
+pub mod gauges;
 pub mod generate;
 pub mod model;
 pub mod prepare;

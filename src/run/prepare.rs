@@ -183,7 +183,7 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
     let t_end = match (scene.loading.end_periods, scene.loading.end_s) {
         (Some(p), _) => p * fundamental.period,
         (None, Some(s)) => s,
-        (None, None) => 10.0 * fundamental.period,
+        (None, None) => crate::scene::DEFAULT_END_PERIODS * fundamental.period,
     };
     let steps = (t_end / dt).ceil() as usize;
     if steps as f64 * n as f64 > 1e14 {

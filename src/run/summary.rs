@@ -5,7 +5,7 @@ use super::model::{ModuliFit, SurfaceCorrection};
 use super::prepare::Prepared;
 use crate::discretise::groups;
 use crate::material::properties::{FieldReport, SampledField};
-use crate::scene::{Scene, SolverMethod};
+use crate::scene::{Scene, SolverMethod, DEFAULT_END_PERIODS, KINETIC_LIMIT};
 use crate::solver::inelastic::ParticleDamage;
 use crate::solver::Record;
 use serde::Serialize;
@@ -66,6 +66,8 @@ pub struct Summary {
     /// (force_displacement.svg turns both axes and says so); the displacements keep their
     /// sign.
     pub sign_turned: bool,
+    /// Each gauge (`[[gauges]]`): its opening at the peak, at the end and its largest.
+    pub gauges: Vec<GaugeReport>,
     /// External work not found in kinetic, elastic or damper energy (damage and plasticity;
     /// for an elastic scene a measure of the energy error).
     #[serde(rename = "dissipated_energy_J")]
@@ -140,6 +142,63 @@ pub struct Summary {
 /// quasi-static where the result might otherwise depend on inertia the specimen does not
 /// have (added mass).
 pub const QUASI_STATIC_LIMIT: f64 = 0.01;
+
+/// The warning of an explicit run whose kinetic energy around the peak exceeded
+/// [`KINETIC_LIMIT`] × the internal energy, with the loading time that brings it to half the
+/// limit: the ratio falls as the square of the loading time (benchmarks/RESULTS.md,
+/// "Loading rate").
+fn loading_warning<const K: usize, const D: usize>(
+    p: &Prepared<K, D>,
+    method: SolverMethod,
+    ratio: f64,
+) -> Option<String> {
+    if method != SolverMethod::Explicit || !(ratio > KINETIC_LIMIT) {
+        return None;
+    }
+    let factor = (ratio / (0.5 * KINETIC_LIMIT)).sqrt();
+    let l = &p.model.scene.loading;
+    let fix = match l.end_s {
+        Some(s) => format!("loading.end_s = {:.3e}", s * factor),
+        None => format!(
+            "loading.end_periods = {:.0}",
+            (l.end_periods.unwrap_or(DEFAULT_END_PERIODS) * factor).ceil()
+        ),
+    };
+    Some(format!(
+        "the kinetic energy reached {ratio:.3} × the internal energy around the peak, above the quasi-static {KINETIC_LIMIT}: inertia may have raised the peak; load more slowly, e.g. {fix}"
+    ))
+}
+
+/// A gauge's readings in summary.json (m).
+#[derive(Clone, Debug, Serialize)]
+pub struct GaugeReport {
+    pub name: String,
+    /// At the record of the peak force.
+    pub at_peak_m: f64,
+    #[serde(rename = "final_m")]
+    pub last_m: f64,
+    /// The largest reading of the run.
+    pub max_m: f64,
+}
+
+/// The reports of the scene's gauges over `records`, with the peak record `peak`.
+fn gauge_reports(
+    scene: &crate::scene::Scene,
+    records: &[Record],
+    peak: Option<&Record>,
+) -> Vec<GaugeReport> {
+    scene
+        .gauges
+        .iter()
+        .enumerate()
+        .map(|(k, g)| GaugeReport {
+            name: g.name.clone(),
+            at_peak_m: peak.map(|r| r.gauges[k]).unwrap_or(0.0),
+            last_m: records.last().map(|r| r.gauges[k]).unwrap_or(0.0),
+            max_m: records.iter().map(|r| r.gauges[k]).fold(0.0, f64::max),
+        })
+        .collect()
+}
 
 /// What a random body reports in summary.json.
 #[derive(Clone, Debug, Serialize)]
@@ -368,6 +427,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         final_displacement_m: last.displacement_m,
         final_force_n: last.force_n * sign,
         sign_turned: sign < 0.0,
+        gauges: gauge_reports(&p.model.scene, records, peak),
         dissipated_energy_j: last.external_work_j
             - last.kinetic_j
             - last.internal_j
@@ -409,6 +469,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
             .warnings
             .iter()
             .cloned()
+            .chain(loading_warning(p, method, ratio))
             .chain(p.mass_scaling
             .filter(|_| ratio > QUASI_STATIC_LIMIT)
             .map(|m| {

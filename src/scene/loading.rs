@@ -34,7 +34,8 @@ pub struct LoadingSpec {
     /// t_ramp / t_end (5.5 uses 0.8).
     #[serde(default = "default_ramp_fraction")]
     pub ramp_fraction: f64,
-    /// t_end as a multiple of the computed fundamental period T1.
+    /// t_end as a multiple of the computed fundamental period T1; without it and without
+    /// `end_s`, [`DEFAULT_END_PERIODS`].
     #[serde(default)]
     pub end_periods: Option<f64>,
     /// t_end in seconds (instead of end_periods).
@@ -150,3 +151,15 @@ impl Default for DampingSpec {
         }
     }
 }
+
+/// t_end / T1 of a scene that gives neither `loading.end_periods` nor `loading.end_s`.
+/// Measured on the 2D three-point bending beams of lattices/ with their strokes: the largest
+/// kinetic/internal energy ratio around the peak of the notched beam is 0.36, 0.098 and
+/// 0.027 at 10, 20 and 40 periods (about 36/n², as a load rate ∝ 1/n predicts); the
+/// unnotched beam on random particles, which snaps at its peak, reads 0.050 at 40. 60
+/// periods keep every beam below [`KINETIC_LIMIT`] (benchmarks/RESULTS.md, "Loading rate").
+pub const DEFAULT_END_PERIODS: f64 = 60.0;
+
+/// The largest kinetic/internal energy ratio around the peak of a run that counts as
+/// quasi-static: above it the run warns, with the loading time that would bring it below.
+pub const KINETIC_LIMIT: f64 = 0.05;

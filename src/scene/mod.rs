@@ -6,6 +6,7 @@
 mod body;
 pub mod concrete;
 mod discretisation;
+pub mod gauge;
 mod loading;
 mod overrides;
 mod plausible;
@@ -16,7 +17,9 @@ mod validate;
 
 pub use body::{BodySpec, CutoutSpec};
 pub use discretisation::{Discretisation, DiscretisationSpec, Lattice, Rotation, Surface};
-pub use loading::{BondScheme, DampingSpec, LoadSpec, LoadingSpec, Pace, Ramp};
+pub use loading::{
+    BondScheme, DampingSpec, LoadSpec, LoadingSpec, Pace, Ramp, DEFAULT_END_PERIODS, KINETIC_LIMIT,
+};
 pub use overrides::apply_overrides;
 pub use solver_settings::{ControlSpec, ForceLag, SolverMethod, SolverSpec};
 pub use validate::SceneError;
@@ -61,6 +64,9 @@ pub struct Scene {
     pub solver: SolverSpec,
     #[serde(default)]
     pub output: OutputSpec,
+    /// Openings measured during the run (`[[gauges]]`): CMOD, LVDTs.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub gauges: Vec<gauge::GaugeSpec>,
     /// Every material value the run uses and where it came from (scene, preset or
     /// correlation), filled by [`Scene::resolve`]; not read from the file.
     #[serde(skip_deserializing)]
@@ -371,8 +377,11 @@ pub enum Selection {
     Strip {
         edge: Edge,
         width: f64,
+        /// The strip's middle (m): the x coordinate on a bottom or top edge, the y
+        /// coordinate on a left or right one; default the middle of the body's extent
+        /// along the edge.
         #[serde(default)]
-        centre: f64,
+        centre: Option<f64>,
         #[serde(default)]
         depth: Option<f64>,
     },

@@ -1,6 +1,7 @@
 //! Time integration of a discretised specimen: the step kernel, displacement loading,
 //! probes (reaction force, energies) and the stability guard (docs/architecture.md, "Solver").
 
+pub mod gauge;
 pub mod inelastic;
 pub mod kernel;
 pub mod lanczos;
@@ -82,6 +83,8 @@ pub struct Record {
     pub internal_j: f64,
     pub external_work_j: f64,
     pub damping_j: f64,
+    /// The readings of the run's gauges (m), in the scene's order (`[[gauges]]`).
+    pub gauges: [f64; gauge::MAX_GAUGES],
 }
 
 /// The probe: a group and the component along which its reaction is summed.
@@ -273,6 +276,8 @@ pub struct Simulation<const D: usize, const K: usize> {
     held: Option<HeldLoad>,
     /// The load clock of an adaptive pace (`pace`), `None` for the fixed ramp in time.
     clock: Option<LoadClock>,
+    /// The gauges each record reads (`[[gauges]]`).
+    pub gauges: Vec<gauge::Gauge<D>>,
 }
 
 /// The load time τ of an adaptive pace: the ramp is read at τ = t + lead, and the lead grows
@@ -320,6 +325,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             inelastic: None,
             held: None,
             clock: None,
+            gauges: Vec::new(),
         };
         // The elastic energy at rest is not zero to round-off (positions far from the origin
         // or offset by many cells, rotated lattices): it is initial energy, part of E0.
@@ -535,6 +541,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 internal_j: self.internal_energy_now(),
                 external_work_j: self.external_work + work_half,
                 damping_j: self.state.damping_work.iter().sum(),
+                gauges: gauge::readings(&self.gauges, &self.state.x, &self.x0),
             }
         });
         self.external_work += work;

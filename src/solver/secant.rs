@@ -670,6 +670,7 @@ pub fn solve<const D: usize, const K: usize>(
             internal_j: sim.internal_energy_now(),
             external_work_j: work,
             damping_j: 0.0,
+            gauges: super::gauge::readings(&sim.gauges, &sim.state.x, &sim.x0),
         }
     };
     let f0 = sim

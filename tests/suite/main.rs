@@ -2,6 +2,7 @@
 //! The long physics validations are ignored here unless the `validation` feature is on
 //! (`cargo test --release --features validation`, which CI runs after the fast suite).
 
+mod bending;
 mod cli;
 #[path = "../common/mod.rs"]
 mod common;

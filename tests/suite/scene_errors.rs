@@ -277,12 +277,7 @@ fn impossible_values_name_key_value_and_what_is_allowed() {
 }
 
 #[test]
-fn missing_end_time_and_reactionless_probe_are_refused() {
-    let text = BASE.replace("[loading]\nend_periods = 2.0\n", "");
-    says(
-        &error_of_text(&text),
-        &["loading.end_periods", "(missing)", "loading.end_s"],
-    );
+fn a_reactionless_probe_is_refused() {
     let text = format!("{BASE}\n[[groups]]\nname = \"mid\"\nselect = {{ by = \"all\" }}\n[output]\nprobe_group = \"mid\"\n");
     says(
         &error_of_text(&text),

@@ -75,7 +75,9 @@ impl Scene {
                     ));
                 }
                 positive(&format!("{key}.select.width"), *width)?;
-                finite(&format!("{key}.select.centre"), *centre)?;
+                if let Some(c) = centre {
+                    finite(&format!("{key}.select.centre"), *c)?;
+                }
                 if let Some(dp) = depth {
                     positive(&format!("{key}.select.depth"), *dp)?;
                 }

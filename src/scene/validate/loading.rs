@@ -2,7 +2,7 @@
 //! damping ratios.
 
 use super::{invalid, positive, SceneError};
-use crate::scene::{Scene, SolverMethod};
+use crate::scene::Scene;
 
 impl Scene {
     pub(super) fn validate_loading(&self) -> Result<(), SceneError> {
@@ -33,16 +33,8 @@ impl Scene {
                 }
             }
             (None, Some(s)) => positive("loading.end_s", s)?,
-            (None, None) => {
-                let any_load = self.groups.iter().any(|g| g.load.is_some());
-                if any_load && self.solver.method == SolverMethod::Explicit {
-                    return Err(invalid(
-                        "loading.end_periods",
-                        "(missing)",
-                        "a scene with a loaded group needs loading.end_periods (multiples of the computed fundamental period) or loading.end_s",
-                    ));
-                }
-            }
+            // the default, DEFAULT_END_PERIODS
+            (None, None) => {}
         }
         if let Some(f) = l.stop_after_peak {
             if !(f > 0.0 && f < 1.0) {

@@ -5,6 +5,7 @@
 mod body;
 mod cutouts;
 mod discretisation;
+mod gauges;
 mod groups;
 mod loading;
 mod material;
@@ -121,7 +122,8 @@ impl Scene {
         self.validate_loading()?;
         self.validate_damping()?;
         self.validate_solver()?;
-        self.validate_output()
+        self.validate_output()?;
+        self.validate_gauges()
     }
 
     /// The name, the body, its cutouts and the discretisation: what the material's

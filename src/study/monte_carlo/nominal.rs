@@ -158,15 +158,15 @@ fn loaded_component(scene: &Scene) -> Option<usize> {
 
 /// The x-position of a group that sits at one place along a beam: the middle of a box, the
 /// point of `nearest`, the centre of a strip on the top or bottom edge.
-fn x_position(g: &GroupSpec) -> Option<f64> {
+fn x_position(scene: &Scene, g: &GroupSpec) -> Option<f64> {
     match &g.select {
         Selection::Box { min, max } => Some(0.5 * (min[0] + max[0])),
         Selection::Nearest { point } => Some(point[0]),
         Selection::Strip {
-            edge: Edge::Top | Edge::Bottom,
+            edge: edge @ (Edge::Top | Edge::Bottom),
             centre,
             ..
-        } => Some(*centre),
+        } => crate::discretise::groups::strip_centre_on(*centre, *edge, &scene.shape()),
         _ => None,
     }
 }
@@ -182,12 +182,12 @@ pub fn three_point_span(scene: &Scene) -> Option<f64> {
     if load.load.as_ref()?.component.index() != 1 {
         return None;
     }
-    let x_load = x_position(load)?;
+    let x_load = x_position(scene, load)?;
     let supports: Vec<f64> = scene
         .groups
         .iter()
         .filter(|g| g.load.is_none() && g.fix.iter().any(|a| a.index() == 1))
-        .filter_map(x_position)
+        .filter_map(|g| x_position(scene, g))
         .collect();
     let lo = supports.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = supports.iter().copied().fold(f64::NEG_INFINITY, f64::max);
