@@ -152,7 +152,7 @@ fn loading_warning<const K: usize, const D: usize>(
     method: SolverMethod,
     ratio: f64,
 ) -> Option<String> {
-    if method != SolverMethod::Explicit || !(ratio > KINETIC_LIMIT) {
+    if method != SolverMethod::Explicit || ratio.is_nan() || ratio <= KINETIC_LIMIT {
         return None;
     }
     let factor = (ratio / (0.5 * KINETIC_LIMIT)).sqrt();

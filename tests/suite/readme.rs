@@ -179,3 +179,50 @@ fn the_size_variant_rule_is_stated_as_the_code_applies_it() {
         }
     }
 }
+
+/// The README's "Your own scene": the frames it gives are the bodies' bounding boxes, the
+/// default loading time and the warning's limit are the code's, and a strip without a
+/// centre sits at the middle of its edge.
+#[test]
+fn your_own_scene_states_what_the_code_does() {
+    let text = readme();
+    assert!(text.contains(&format!(
+        "loaded over {} fundamental periods",
+        sppm::scene::DEFAULT_END_PERIODS
+    )));
+    assert!(text.contains(&format!(
+        "kinetic energy exceeds {} of its internal",
+        sppm::scene::KINETIC_LIMIT
+    )));
+    for (row, body, lo, hi) in [
+        (
+            "| `notched_beam` | x in [0, length], y in [0, depth]",
+            "shape = \"notched_beam\"\nlength = 0.175\ndepth = 0.05\nnotch_depth = 0.01\nnotch_width = 0.002",
+            [0.0, 0.0],
+            [0.175, 0.05],
+        ),
+        (
+            "| `dogbone` | x in [−D/2, D/2], y in [0, 1.5·D]",
+            "shape = \"dogbone\"\nsize = 0.1",
+            [-0.05, 0.0],
+            [0.05, 0.15],
+        ),
+        (
+            "| `rectangle` | x in [origin.x, origin.x + width], y in [origin.y, origin.y + height]; origin default [0, 0]",
+            "shape = \"rectangle\"\nwidth = 0.2\nheight = 0.1",
+            [0.0, 0.0],
+            [0.2, 0.1],
+        ),
+    ] {
+        assert!(text.contains(row), "{row}");
+        let scene = sppm::Scene::from_toml_str(
+            &format!("[body]\n{body}\n[discretisation]\nspacing = 0.01\n[material]\nE = 30e9\nnu = 0.2\nrho = 2400.0\nthickness = 0.05\n"),
+            &[],
+        )
+        .unwrap();
+        let (a, b) = scene.shape().bounding_box();
+        for k in 0..2 {
+            assert!((a[k] - lo[k]).abs() < 1e-12 && (b[k] - hi[k]).abs() < 1e-12, "{row}: {a:?} {b:?}");
+        }
+    }
+}
