@@ -113,7 +113,17 @@ where
             per_step * most as f64
         );
     } else {
-        say!("t_end            {:.6e} s", p.t_end);
+        let l = &sc.loading;
+        let default = if l.end_periods.is_none() && l.end_s.is_none() {
+            " (the default loading time, loading.end_periods)"
+        } else {
+            ""
+        };
+        say!(
+            "t_end            {:.6e} s = {:.1} T1{default}",
+            p.t_end,
+            p.t_end / p.fundamental.period
+        );
         say!("steps            {}", p.steps);
         say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
         say!(

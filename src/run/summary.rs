@@ -143,6 +143,27 @@ pub struct Summary {
 /// have (added mass).
 pub const QUASI_STATIC_LIMIT: f64 = 0.01;
 
+/// What the run did that may have changed its result: the scene's inputs outside their
+/// usual range, a load too fast ([`loading_warning`]), added mass with a kinetic energy
+/// above the quasi-static limit.
+fn run_warnings<const K: usize, const D: usize>(
+    p: &Prepared<K, D>,
+    method: SolverMethod,
+    ratio: f64,
+) -> Vec<String> {
+    let mass = p.mass_scaling.filter(|_| ratio > QUASI_STATIC_LIMIT).map(|m| {
+        format!(
+            "solver.mass_scaling added {:.2}% of the mass and the kinetic energy reached {ratio:.3e} × the elastic energy around the peak, above the quasi-static {QUASI_STATIC_LIMIT}: the added mass may have changed the result; lower solver.mass_scaling or leave it out",
+            100.0 * m.added_mass_fraction
+        )
+    });
+    let scene = p.model.scene.warnings.iter().cloned();
+    scene
+        .chain(loading_warning(p, method, ratio))
+        .chain(mass)
+        .collect()
+}
+
 /// The warning of an explicit run whose kinetic energy around the peak exceeded
 /// [`KINETIC_LIMIT`] × the internal energy, with the loading time that brings it to half the
 /// limit: the ratio falls as the square of the loading time (benchmarks/RESULTS.md,
@@ -463,22 +484,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         bond_damping_ratio_at_omega_max: p.stable.zeta,
         bond_damper_implicit_share: p.stable.implicit_share,
         mass_scaling: p.mass_scaling,
-        warnings: p
-            .model
-            .scene
-            .warnings
-            .iter()
-            .cloned()
-            .chain(loading_warning(p, method, ratio))
-            .chain(p.mass_scaling
-            .filter(|_| ratio > QUASI_STATIC_LIMIT)
-            .map(|m| {
-                format!(
-                    "solver.mass_scaling added {:.2}% of the mass and the kinetic energy reached {ratio:.3e} × the elastic energy around the peak, above the quasi-static {QUASI_STATIC_LIMIT}: the added mass may have changed the result; lower solver.mass_scaling or leave it out",
-                    100.0 * m.added_mass_fraction
-                )
-            }))
-            .collect(),
+        warnings: run_warnings(p, method, ratio),
         pace: p.model.scene.pace(),
         seed: p.model.scene.effective_seed(),
         random_fields: p.model.fields.iter().map(|f| f.report.clone()).collect(),
