@@ -48,11 +48,7 @@ pub fn base64(bytes: &[u8]) -> String {
 }
 
 /// Write one binary DataArray: the UInt64 byte count and the data, each base64-encoded.
-fn data_array(
-    w: &mut impl Write,
-    attributes: &str,
-    bytes: &[u8],
-) -> std::io::Result<()> {
+fn data_array(w: &mut impl Write, attributes: &str, bytes: &[u8]) -> std::io::Result<()> {
     writeln!(
         w,
         "        <DataArray {attributes} format=\"binary\">{}{}</DataArray>",
@@ -102,7 +98,10 @@ pub fn write_vtu(
         }
         writeln!(w, "    </FieldData>")?;
     }
-    writeln!(w, "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">")?;
+    writeln!(
+        w,
+        "    <Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">"
+    )?;
     writeln!(w, "      <PointData>")?;
     for a in arrays {
         let (kind, bytes, len) = match &a.values {

@@ -120,7 +120,9 @@ impl<'a, const K: usize, const D: usize> Recorder<'a, K, D> {
             probe
                 .members
                 .iter()
-                .map(|&i| sim.state.x[i as usize][probe.component] - sim.x0[i as usize][probe.component])
+                .map(|&i| {
+                    sim.state.x[i as usize][probe.component] - sim.x0[i as usize][probe.component]
+                })
                 .sum::<f64>()
                 / probe.members.len() as f64
         };
@@ -149,7 +151,11 @@ impl<'a, const K: usize, const D: usize> Recorder<'a, K, D> {
         damage: Option<&[ParticleDamage]>,
     ) -> Vec<Snapshot> {
         let fraction = self.last.clamp(0.0, 1.0);
-        if self.taken.last().is_some_and(|f| f.load_fraction >= fraction) {
+        if self
+            .taken
+            .last()
+            .is_some_and(|f| f.load_fraction >= fraction)
+        {
             self.taken.pop();
         }
         self.take(sim, fraction, stress.to_vec(), damage);
