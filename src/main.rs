@@ -180,8 +180,18 @@ fn run_scene(
         for w in &s.warnings {
             eprintln!("warning: {w}");
         }
-        for f in &files {
+        // the frames of a time series in one line
+        let frame = |f: &PathBuf| {
+            f.file_name()
+                .is_some_and(|n| sppm::output::snapshots::is_frame_file(&n.to_string_lossy()))
+        };
+        for f in files.iter().filter(|f| !frame(f)) {
             say!("wrote {}", f.display());
+        }
+        let frames = files.iter().filter(|f| frame(f)).count();
+        if frames > 0 {
+            let folder = dir.join(sppm::output::snapshots::FOLDER);
+            say!("wrote {} frames in {}", frames, folder.display());
         }
     }
     if let (Some(k @ 1..), Some(r), false) = (

@@ -51,12 +51,28 @@ fn equivalent(
     in_plane: fn(&nalgebra::Matrix2<f64>) -> f64,
     solid: fn(&nalgebra::Matrix3<f64>) -> f64,
 ) -> f64 {
-    if o.dim == 2 {
-        in_plane(&o.stress2(i))
+    scalar_of(o.dim, &o.stress[i], in_plane, solid)
+}
+
+/// A scalar of a Voigt stress [xx, yy, zz, yz, xz, xy]: of its in-plane tensor in 2D, of the
+/// full tensor in 3D.
+fn scalar_of(
+    dim: usize,
+    s: &[f64; 6],
+    in_plane: fn(&nalgebra::Matrix2<f64>) -> f64,
+    solid: fn(&nalgebra::Matrix3<f64>) -> f64,
+) -> f64 {
+    if dim == 2 {
+        in_plane(&nalgebra::Matrix2::new(s[0], s[5], s[5], s[1]))
     } else {
-        let s = &o.stress[i];
         solid(&nalgebra::Matrix3::new(
             s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2],
         ))
     }
+}
+
+/// The von Mises stress of a Voigt stress [xx, yy, zz, yz, xz, xy] in the unit of the stress
+/// (plane stress of the in-plane tensor in 2D, as the maps show it).
+pub fn von_mises(dim: usize, s: &[f64; 6]) -> f64 {
+    scalar_of(dim, s, Dim::<2>::von_mises, Dim::<3>::von_mises)
 }

@@ -1,23 +1,27 @@
 //! Reports of a run (docs/architecture.md, "Interfaces"): summary.json, force_displacement.csv,
 //! increments.csv (relaxation and quasi-static runs), particles.csv,
 //! force_displacement.svg, force_gauge_<name>.svg (each gauge), crack_map.svg (scenes with
-//! damage), random_field_<property>.svg (each
-//! random field, with the crack on top), particle_map.svg and particles.vtk in the run's folder.
+//! damage), random_field_<property>.svg (each random field, with the crack on top),
+//! particle_map.svg and particles.vtk in the run's folder; with `output.snapshots`, the time
+//! series (snapshots.pvd and snapshots/frame_NNNN.vtu) and, with damage, crack_growth.html.
 
+pub mod animation;
 pub mod csv;
 pub mod fields;
 pub mod plots;
 pub mod section;
+pub mod snapshots;
 pub mod vtk;
+pub mod vtu;
 
 use crate::fsio;
 use crate::run::Outcome;
 use std::path::{Path, PathBuf};
 
-/// The files of a run that sppm owns in its folder (besides `random_field_<property>.svg`
-/// and `force_gauge_<name>.svg`):
-/// a new run into the folder replaces them all, so the folder only ever holds one run.
-pub const RUN_FILES: [&str; 8] = [
+/// The files of a run that sppm owns in its folder (besides `random_field_<property>.svg`,
+/// `force_gauge_<name>.svg` and the frames in `snapshots/`, [`snapshots::is_frame_file`]): a
+/// new run into the folder replaces them all, so the folder only ever holds one run.
+pub const RUN_FILES: [&str; 10] = [
     "summary.json",
     "force_displacement.csv",
     "increments.csv",
@@ -26,6 +30,8 @@ pub const RUN_FILES: [&str; 8] = [
     "crack_map.svg",
     "particle_map.svg",
     "particles.vtk",
+    snapshots::PVD,
+    "crack_growth.html",
 ];
 
 /// Is `name` a file that a run writes into its folder?
@@ -41,7 +47,7 @@ pub fn is_run_file(name: &str) -> bool {
 /// output is ever seen half-written. The earlier run's summary.json goes first and the new
 /// one is written last: a folder whose summary.json is missing holds an unfinished write.
 /// Files of an earlier run that this run does not write (a crack map, a random-field map,
-/// the VTK file) are removed, so the folder holds one run only.
+/// the VTK file, frames of a time series) are removed, so the folder holds one run only.
 pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|e| fsio::IoFailure::new("create the folder", dir, e))?;
     let summary = dir.join("summary.json");
@@ -107,6 +113,16 @@ pub fn write_all(outcome: &Outcome, dir: &Path) -> anyhow::Result<Vec<PathBuf>> 
         put("particles.vtk".into(), &|f| {
             vtk::write_particles(outcome, f)
         })?;
+    }
+    if outcome.snapshots.is_empty() {
+        snapshots::remove_stale_frames(dir, &[])?;
+    } else {
+        files.extend(snapshots::write_series(outcome, dir)?);
+        if let Some(html) = animation::crack_growth_html(outcome) {
+            let f = dir.join("crack_growth.html");
+            fsio::write_atomic(&f, html.as_bytes())?;
+            files.push(f);
+        }
     }
     remove_stale(dir, &files)?;
     write_summary(outcome, dir)?;

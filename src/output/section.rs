@@ -9,12 +9,18 @@
 
 use crate::run::Outcome;
 
-/// The view of a 3D outcome on its section (particles, displacements, stresses, damage and
-/// groups restricted to the slab, coordinates in the plane first); a 2D outcome as it is.
-pub fn section_view(o: &Outcome) -> Outcome {
-    if o.dim != 3 || o.x0.is_empty() {
-        return o.clone();
-    }
+/// A 3D outcome's section: the particles within half a spacing of the mid-plane, the plane's
+/// normal axis and position, and its in-plane axes (u, v).
+pub struct Section {
+    pub keep: Vec<usize>,
+    pub normal: usize,
+    pub mid: f64,
+    pub u: usize,
+    pub v: usize,
+}
+
+/// The section of a 3D outcome (the module doc says which plane).
+pub fn section(o: &Outcome) -> Section {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for x in &o.x0 {
         for d in 0..3 {
@@ -38,12 +44,34 @@ pub fn section_view(o: &Outcome) -> Outcome {
         1 => (0, 2),
         _ => (1, 2),
     };
-    let names = ["x", "y", "z"];
     let mid = 0.5 * (lo[normal] + hi[normal]);
     let half = 0.5 * o.summary.spacing_m;
-    let keep: Vec<usize> = (0..o.x0.len())
+    let keep = (0..o.x0.len())
         .filter(|&i| (o.x0[i][normal] - mid).abs() <= half)
         .collect();
+    Section {
+        keep,
+        normal,
+        mid,
+        u,
+        v,
+    }
+}
+
+/// The view of a 3D outcome on its section (particles, displacements, stresses, damage and
+/// groups restricted to the slab, coordinates in the plane first); a 2D outcome as it is.
+pub fn section_view(o: &Outcome) -> Outcome {
+    if o.dim != 3 || o.x0.is_empty() {
+        return o.clone();
+    }
+    let Section {
+        keep,
+        normal,
+        mid,
+        u,
+        v,
+    } = section(o);
+    let names = ["x", "y", "z"];
     let mut index = vec![u32::MAX; o.x0.len()];
     for (k, &i) in keep.iter().enumerate() {
         index[i] = k as u32;
@@ -60,6 +88,7 @@ pub fn section_view(o: &Outcome) -> Outcome {
     view.x0 = keep.iter().map(|&i| permute(&o.x0[i])).collect();
     view.displacement = keep.iter().map(|&i| permute(&o.displacement[i])).collect();
     view.stress = keep.iter().map(|&i| voigt(&o.stress[i])).collect();
+    view.volume = keep.iter().map(|&i| o.volume[i]).collect();
     view.damage = o
         .damage
         .as_ref()

@@ -1,6 +1,7 @@
 //! Legacy binary VTK (an unstructured grid of vertex cells, one per particle) for ParaView,
-//! with displacement, stress tensor, von Mises and maximum principal stress, and group
-//! membership as point data, and each random field's values (e.g. `ft_MPa`). Checked with meshio's reader.
+//! with displacement, stress tensor, von Mises and maximum principal stress, the particle's
+//! volume (`volume_m3`) and index (`id`), and group membership as point data, and each
+//! random field's values (e.g. `ft_MPa`). Checked with meshio's reader.
 
 use super::fields;
 use crate::run::Outcome;
@@ -88,6 +89,14 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
         for v in &f.values {
             be(&mut w, v * unit)?;
         }
+    }
+    writeln!(w, "\nSCALARS volume_m3 float 1\nLOOKUP_TABLE default")?;
+    for v in &o.volume {
+        be(&mut w, *v)?;
+    }
+    writeln!(w, "\nSCALARS id int 1\nLOOKUP_TABLE default")?;
+    for i in 0..n {
+        w.write_all(&(i as i32).to_be_bytes())?;
     }
     for g in &o.groups {
         let mut member = vec![0.0; n];

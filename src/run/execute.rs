@@ -6,6 +6,7 @@ use super::generate::Generator;
 use super::model::Model;
 use super::prepare::{prepare, Prepared};
 use super::recover::{Recover, Recovered};
+use super::snapshots::Recorder;
 use super::summary::{point3, summarise, Finished, Outcome, SolverReport};
 use super::{RunError, RunOptions};
 use crate::material::properties;
@@ -229,11 +230,12 @@ fn run_prepared<const K: usize, const D: usize>(
         amplitude: 0.0,
     };
     let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
+    let mut recorder = Recorder::of(&p, probe, recover);
     let mut increments = Vec::new();
     let (records, wall_s, failure, report) = match method {
         SolverMethod::Explicit => {
             let (records, wall_s, failure, stopped) =
-                run_explicit(&mut sim, &p, probe, opts, start);
+                run_explicit(&mut sim, &p, probe, opts, start, recorder.as_mut());
             let report = SolverReport {
                 stopped_after_peak: stopped,
                 ..Default::default()
@@ -247,10 +249,15 @@ fn run_prepared<const K: usize, const D: usize>(
             // scenes with damage: the implicit secant solver; elastic scenes have no state
             // to hold, and relax (docs/quasi_static.md)
             let implicit = quasi_static && sim.inelastic.is_some();
+            let mut observe = |sim: &Simulation<D, K>, fraction: f64| {
+                if let Some(r) = recorder.as_mut() {
+                    r.observe(sim, fraction)
+                }
+            };
             let r = if implicit {
-                crate::solver::secant::solve(&mut sim, probe, &settings, start)
+                crate::solver::secant::solve(&mut sim, probe, &settings, start, &mut observe)
             } else {
-                relaxation::relax(&mut sim, probe, &settings, start)
+                relaxation::relax(&mut sim, probe, &settings, start, &mut observe)
             };
             let report = SolverReport {
                 iterations: Some(r.iterations),
@@ -276,6 +283,9 @@ fn run_prepared<const K: usize, const D: usize>(
         .map(|(a, b)| point3(&(a - b)))
         .collect();
     let (stress, damage) = recover(&p, &sim);
+    let snapshots = recorder
+        .map(|r| r.finish(&sim, &stress, damage.as_deref()))
+        .unwrap_or_default();
     let summary = summarise(
         &p,
         &Finished {
@@ -309,6 +319,7 @@ fn run_prepared<const K: usize, const D: usize>(
         increments,
         dim: D,
         x0: p.model.particles.x0.iter().map(point3).collect(),
+        volume: p.model.particles.volume.clone(),
         displacement,
         stress,
         damage,
@@ -316,6 +327,7 @@ fn run_prepared<const K: usize, const D: usize>(
         scene: p.model.scene.clone(),
         fields: p.model.fields.clone(),
         axes: ["x", "y"],
+        snapshots: std::sync::Arc::new(snapshots),
     };
     Ok(outcome)
 }
@@ -323,13 +335,15 @@ fn run_prepared<const K: usize, const D: usize>(
 /// The explicit run to t_end with probe records (and the wall time at each), stopping at an
 /// instability, or after the peak with `loading.stop_after_peak` (then `true`). With an
 /// adaptive pace (`loading.pace`) the records are spread over the load time τ and the run
-/// ends when τ reaches t_end.
+/// ends when τ reaches t_end. With `snapshots`, the frames due at each step's load time
+/// τ/t_end are taken (`run::snapshots`).
 fn run_explicit<const K: usize, const D: usize>(
     sim: &mut Simulation<D, K>,
     p: &Prepared<K, D>,
     probe: &Probe,
     opts: &RunOptions,
     start: Instant,
+    mut snapshots: Option<&mut Recorder<K, D>>,
 ) -> (Vec<Record>, Vec<f64>, Option<crate::solver::Unstable>, bool) {
     let scene = &p.model.scene;
     let mut stop = PeakStop::new(scene.loading.stop_after_peak, probe);
@@ -358,6 +372,9 @@ fn run_explicit<const K: usize, const D: usize>(
             }
         };
         let rec = sim.advance(if want { Some(probe) } else { None });
+        if let Some(s) = snapshots.as_deref_mut() {
+            s.observe(sim, sim.load_time() / p.t_end);
+        }
         if let Some(r) = rec {
             records.push(r);
             wall_s.push(start.elapsed().as_secs_f64());

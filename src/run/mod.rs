@@ -19,6 +19,7 @@ pub mod generate;
 pub mod model;
 pub mod prepare;
 pub mod recover;
+pub mod snapshots;
 pub mod stress_recovery;
 pub mod summary;
 

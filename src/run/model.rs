@@ -121,8 +121,14 @@ pub fn estimated_particles(scene: &Scene) -> f64 {
 }
 
 /// Estimated bytes a run of the scene allocates in `slots` bond slots (2D or 3D; with
-/// `[concrete]`, the damage kernel's too).
+/// `[concrete]`, the damage kernel's too; with `output.snapshots`, the frames).
 pub fn memory_in_slots(scene: &Scene, slots: usize) -> f64 {
+    model_memory(scene, slots) + frames_memory(scene)
+}
+
+/// Estimated bytes of the model's arrays in `slots` bond slots (with `[concrete]`, the damage
+/// kernel's too).
+fn model_memory(scene: &Scene, slots: usize) -> f64 {
     let dim = scene.dim();
     let damage = if scene.concrete.is_some() {
         crate::solver::inelastic::bytes_per_particle(dim, slots)
@@ -132,13 +138,31 @@ pub fn memory_in_slots(scene: &Scene, slots: usize) -> f64 {
     estimated_particles(scene) * (bytes_per_particle(dim, slots) + damage) as f64
 }
 
-/// Refuse a scene whose body would not fit this machine's memory (80% of what is available)
-/// or that has more particles than a run can index, before anything is allocated; `slots`
+/// Estimated bytes of the frames of `output.snapshots` (0 without).
+pub fn frames_memory(scene: &Scene) -> f64 {
+    let frames = scene.output.snapshots.unwrap_or(0) as f64;
+    frames * estimated_particles(scene) * super::snapshots::FRAME_BYTES_PER_PARTICLE as f64
+}
+
+/// Refuse a scene whose body, or its frames (`output.snapshots`), would not fit this machine's
+/// memory (80% of what is available) or that has more particles than a run can index, before anything is allocated; `slots`
 /// are the bond slots of its discretisation.
 pub(crate) fn check_size(scene: &Scene, slots: usize) -> Result<(), RunError> {
     let d = &scene.discretisation;
-    let need = memory_in_slots(scene, slots);
+    let need = model_memory(scene, slots);
     if let Some(avail) = available_memory() {
+        let frames = frames_memory(scene);
+        if need <= 0.8 * avail as f64 && need + frames > 0.8 * avail as f64 {
+            let n = scene.output.snapshots.unwrap_or(0);
+            let fit = ((0.8 * avail as f64 - need) / (frames / n as f64)).floor();
+            return Err(RunError::Setup(format!(
+                "output.snapshots = {n}: {n} frames of about {:.3e} particles need about {:.1} GiB besides the model's {:.1} GiB, more than this machine has available ({:.1} GiB); at most {fit:.0} frames fit",
+                estimated_particles(scene),
+                frames / 2f64.powi(30),
+                need / 2f64.powi(30),
+                avail as f64 / 2f64.powi(30)
+            )));
+        }
         if need > 0.8 * avail as f64 {
             return Err(RunError::Setup(format!(
                 "discretisation.spacing = {}: the body would hold about {:.3e} particles needing about {:.1} GiB, more than this machine has available ({:.1} GiB); use a larger spacing",

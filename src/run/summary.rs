@@ -248,6 +248,9 @@ pub struct Outcome {
     /// Spatial dimension of the run (2 or 3).
     pub dim: usize,
     pub x0: Vec<[f64; 3]>,
+    /// Each particle's volume ΔV (m³; in 2D its cell's area × the thickness, clipped to the
+    /// body at a surface).
+    pub volume: Vec<f64>,
     pub displacement: Vec<[f64; 3]>,
     pub stress: Vec<[f64; 6]>,
     /// Damage and plasticity state of each particle at the end (scenes with `[concrete]`).
@@ -259,6 +262,9 @@ pub struct Outcome {
     /// The names of the maps' horizontal and vertical axes: "x", "y" in 2D; a section of a
     /// 3D run (`output::section`) names its own.
     pub axes: [&'static str; 2],
+    /// The frames of the run's time series (`output.snapshots`; empty without), shared by
+    /// the views of the outcome.
+    pub snapshots: std::sync::Arc<Vec<super::snapshots::Snapshot>>,
 }
 
 impl Outcome {

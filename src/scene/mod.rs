@@ -472,6 +472,10 @@ pub struct OutputSpec {
     /// Write a VTK file of the particles.
     #[serde(default = "default_true")]
     pub vtk: bool,
+    /// Frames of the run's time series (`snapshots/`: one `.vtu` file per frame, a `.pvd`
+    /// collection and `crack_growth.html`), spread evenly over the load path; absent: none.
+    #[serde(default)]
+    pub snapshots: Option<usize>,
 }
 
 impl Default for OutputSpec {
@@ -484,6 +488,7 @@ impl Default for OutputSpec {
             crack_map_scale: 0.0,
             map: true,
             vtk: true,
+            snapshots: None,
         }
     }
 }

@@ -334,9 +334,14 @@ fn reaction_work<const D: usize, const K: usize>(
         .sum()
 }
 
+/// Told of the state at the end of each load increment: the simulation and the ramp's time
+/// reached (0 … 1), e.g. to take the frames of a time series (`run::snapshots`).
+pub type Observer<'a, const D: usize, const K: usize> = &'a mut dyn FnMut(&Simulation<D, K>, f64);
+
 /// Run the increments on a simulation at rest whose dampers are off (see [`undamped`]).
 /// Stops early, with `failure` set, if the state blows up, and with `stopped_unconverged`
-/// set at the first increment above [`Settings::stop_unconverged`].
+/// set at the first increment above [`Settings::stop_unconverged`]. `observe` is told of the
+/// state at the end of each increment k (ramp time k/increments).
 ///
 /// (The same pseudo-dynamics with the state held and committed at its equilibria was measured
 /// as the quasi-static solver's first design and dropped: docs/quasi_static.md.)
@@ -345,6 +350,7 @@ pub fn relax<const D: usize, const K: usize>(
     probe: &Probe,
     s: &Settings,
     start: Instant,
+    observe: Observer<D, K>,
 ) -> Relaxed {
     let mut damping = AdaptiveDamping::new(sim);
     let mut predictor = Predictor::new(sim.x0.len());
@@ -427,6 +433,7 @@ pub fn relax<const D: usize, const K: usize>(
             out.failure = Some(e);
             break;
         }
+        observe(sim, k as f64 / s.increments as f64);
         if s.stop_unconverged
             .is_some_and(|limit| !report.converged && report.residual > limit)
         {

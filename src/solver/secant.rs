@@ -633,11 +633,13 @@ impl<const D: usize> Past<D> {
 
 /// Run the increments of a scene with damage (see the module doc). Returns what the
 /// relaxation returns, so the run, the summary and the outputs treat both alike.
+/// `observe` is told of each converged increment's state and the ramp's time it reached.
 pub fn solve<const D: usize, const K: usize>(
     sim: &mut Simulation<D, K>,
     probe: &Probe,
     s: &Settings,
     start: Instant,
+    observe: super::relaxation::Observer<D, K>,
 ) -> Relaxed {
     let control = s.control.as_ref();
     let mut newton = Newton::new(sim, s);
@@ -765,6 +767,7 @@ pub fn solve<const D: usize, const K: usize>(
         let rec = record(sim, &forces, r, past.work, iterations);
         out.records.push(rec);
         out.wall_s.push(start.elapsed().as_secs_f64());
+        observe(sim, time);
         if stop.reached(&rec, sim) {
             out.stopped_after_peak = true;
             break;

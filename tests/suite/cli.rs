@@ -88,7 +88,8 @@ fn run_writes_every_output() {
     let vtk = std::fs::read(out.join("particles.vtk")).unwrap();
     assert!(vtk.starts_with(b"# vtk DataFile Version 3.0"));
     // binary layout: points (12 B), cells (8 B), cell types (4 B), displacement (12 B),
-    // stress tensor (36 B), two scalars and three group flags (4 B each) per particle
+    // stress tensor (36 B), two stress scalars, volume, id and three group flags (4 B each)
+    // per particle
     let n = summary["particles"].as_u64().unwrap() as usize;
     let text = String::from_utf8_lossy(&vtk);
     for marker in [
@@ -96,10 +97,12 @@ fn run_writes_every_output() {
         format!("CELLS {n} {}", 2 * n),
         format!("CELL_TYPES {n}"),
         format!("POINT_DATA {n}"),
+        "SCALARS volume_m3 float 1".into(),
+        "SCALARS id int 1".into(),
     ] {
         assert!(text.contains(&marker), "VTK lacks {marker}");
     }
-    let payload = n * (12 + 8 + 4 + 12 + 36 + 5 * 4);
+    let payload = n * (12 + 8 + 4 + 12 + 36 + 7 * 4);
     assert!(
         vtk.len() > payload && vtk.len() < payload + 1024,
         "VTK size {} vs payload {payload}",

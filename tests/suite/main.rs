@@ -33,6 +33,7 @@ mod reliability;
 mod reliability_studies;
 mod run_plate;
 mod scene_errors;
+mod snapshots;
 mod specimens;
 mod sppm3d;
 mod sppm_concrete;

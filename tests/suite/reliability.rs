@@ -234,10 +234,15 @@ fn a_folder_holds_one_run_only() {
     let out = tmp("stale");
     std::fs::create_dir_all(&out).unwrap();
     // files an earlier run of another scene left, a half-written file, and the user's own
+    std::fs::create_dir_all(out.join("snapshots")).unwrap();
     for f in [
         "crack_map.svg",
         "random_field_ft.svg",
         ".particles.csv.partial",
+        "snapshots.pvd",
+        "crack_growth.html",
+        "snapshots/frame_0003.vtu",
+        "snapshots/.frame_0004.vtu.partial",
     ] {
         std::fs::write(out.join(f), "stale").unwrap();
     }
@@ -249,6 +254,9 @@ fn a_folder_holds_one_run_only() {
         "random_field_ft.svg",
         ".particles.csv.partial",
         "particles.vtk",
+        "snapshots.pvd",
+        "crack_growth.html",
+        "snapshots",
     ] {
         assert!(!out.join(f).exists(), "{f} is still in the folder");
     }

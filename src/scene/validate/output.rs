@@ -1,8 +1,11 @@
-//! `[output]`: the number of records, a probe group with a reaction, and the maps'
-//! magnifications.
+//! `[output]`: the number of records, a probe group with a reaction, the maps'
+//! magnifications and the frames of the time series.
 
 use super::{invalid, SceneError};
 use crate::scene::Scene;
+
+/// The most frames `output.snapshots` may ask for.
+pub const MAX_SNAPSHOTS: usize = 1000;
 
 impl Scene {
     pub(super) fn validate_output(&self) -> Result<(), SceneError> {
@@ -36,6 +39,17 @@ impl Scene {
                     key,
                     v,
                     "a magnification >= 0 (0 draws the reference shape)",
+                ));
+            }
+        }
+        if let Some(n) = o.snapshots {
+            if !(1..=MAX_SNAPSHOTS).contains(&n) {
+                return Err(invalid(
+                    "output.snapshots",
+                    n,
+                    format!(
+                        "an integer from 1 to {MAX_SNAPSHOTS} (frames of the time series; leave the key out for none)"
+                    ),
                 ));
             }
         }
