@@ -60,9 +60,10 @@ pub struct ParticleDamage {
 pub const CRACKED_WT: f64 = 0.99;
 
 /// Compressive damage w_c at and above which the outputs count a particle that is not
-/// cracked as crushed. Compressive damage also follows tensile damage in a crack (4.16), so
-/// a cracked particle is counted as cracked only.
-pub const CRUSHED_WC: f64 = 0.5;
+/// cracked as crushed. Compressive damage also follows tensile damage (4.16): w_c reaches
+/// 0.5 at w_t = 0.62 (w_t,cr = 1/3) in any partly open crack, but 0.99 only at w_t ≥ 0.9916,
+/// so w_c ≥ 0.99 without w_t ≥ 0.99 is the crushing beyond the ultimate strain (4.17).
+pub const CRUSHED_WC: f64 = 0.99;
 
 impl ParticleDamage {
     /// Whether the particle has failed (w_t or w_c ≥ 0.99).

@@ -466,7 +466,7 @@ fn damage_colour(w: f64) -> RGBColor {
 }
 
 /// crack_map.svg: particles coloured by tensile damage w_t (grey intact → dark red fully
-/// cracked), particles with compressive damage w_c ≥ 0.5 that are not cracked marked with a
+/// cracked), crushed particles (w_c ≥ 0.99 without w_t ≥ 0.99) marked with a
 /// black ×, particles that yielded with a blue ring; at x0 + scale·u.
 pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
     let Some(damage) = &o.damage else {
@@ -486,7 +486,7 @@ pub fn crack_map(o: &Outcome, scale: f64, path: &Path) -> anyhow::Result<()> {
         "tensile damage",
         scale,
         format!(
-            "{} (mm)   —   red: w_t (grey 0 → dark red 1; {cracked} with w_t ≥ 0.99)   ×: w_c ≥ 0.5 ({crushed})   blue ring: yielded ({yielded})",
+            "{} (mm)   —   red: w_t (grey 0 → dark red 1; {cracked} with w_t ≥ 0.99)   ×: crushed, w_c ≥ 0.99 ({crushed})   blue ring: yielded ({yielded})",
             o.axes[0]
         ),
         60,

@@ -92,7 +92,7 @@ pub struct Summary {
     pub max_compressive_damage: Option<f64>,
     /// Particles with w_t ≥ 0.99 (`ParticleDamage::cracked`, as the crack map counts them).
     pub cracked_particles: Option<usize>,
-    /// Particles with w_c ≥ 0.5 that are not cracked (`ParticleDamage::crushed`, the crack
+    /// Particles with w_c ≥ 0.99 that are not cracked (`ParticleDamage::crushed`, the crack
     /// map's ×).
     pub crushed_particles: Option<usize>,
     /// Particles that yielded at least once.

@@ -50,7 +50,7 @@ fn summary_counts_are_the_crack_maps() {
         let (o, dir) = run_shipped(file, "0.02");
         let s = &o.summary;
         let svg = std::fs::read_to_string(dir.join("crack_map.svg")).unwrap();
-        let crushed = legend_count(&svg, "w_c ≥ 0.5");
+        let crushed = legend_count(&svg, "crushed, w_c ≥ 0.99");
         let cracked_at = svg.find("with w_t ≥ 0.99").unwrap();
         let before = &svg[..cracked_at];
         let cracked: usize = before
