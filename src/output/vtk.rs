@@ -50,13 +50,14 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
             be(&mut w, v)?;
         }
     }
+    // in Pa, as the stress tensor (the maps' values are in MPa)
     for (name, field) in [
-        ("von_mises_MPa", Field::StressVonMises),
-        ("max_principal_MPa", Field::MaxPrincipalStress),
+        ("von_mises_Pa", Field::StressVonMises),
+        ("max_principal_Pa", Field::MaxPrincipalStress),
     ] {
         writeln!(w, "\nSCALARS {name} float 1\nLOOKUP_TABLE default")?;
         for v in fields::values(o, field) {
-            be(&mut w, v)?;
+            be(&mut w, v * 1e6)?;
         }
     }
     if let Some(d) = &o.damage {

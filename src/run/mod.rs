@@ -11,6 +11,7 @@
 //! displacements, 6-component stresses), so one set of reports serves 2D and 3D. The CLI and
 //! the studies are thin callers.
 
+pub mod arrays;
 pub mod check;
 pub mod dispatch;
 pub mod execute;

@@ -141,8 +141,12 @@ fn model_memory(scene: &Scene, slots: usize) -> f64 {
 /// Estimated bytes of the frames of `output.snapshots` (0 without).
 pub fn frames_memory(scene: &Scene) -> f64 {
     let frames = scene.output.snapshots.unwrap_or(0) as f64;
-    frames * estimated_particles(scene) * super::snapshots::FRAME_BYTES_PER_PARTICLE as f64
+    frames * estimated_particles(scene) * FRAME_BYTES_PER_PARTICLE as f64
 }
+
+/// Bytes one frame of a time series (`run::snapshots`) holds per particle: displacement
+/// (3), stress (6) and the two damages (2), f64 each.
+pub const FRAME_BYTES_PER_PARTICLE: usize = (3 + 6 + 2) * 8;
 
 /// Refuse a scene whose body, or its frames (`output.snapshots`), would not fit this machine's
 /// memory (80% of what is available) or that has more particles than a run can index, before anything is allocated; `slots`

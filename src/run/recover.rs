@@ -1,9 +1,9 @@
 //! The stress a run reports of each particle at its end, in its dimension: 2D recovers
 //! D_i·ε_i (run::stress_recovery), 3D takes D·ε_i of each particle's least-squares strain.
 
+use super::arrays::voigt6;
 use super::prepare::Prepared;
 use super::stress_recovery;
-use super::summary::voigt6;
 use crate::model::dimension::Dim;
 use crate::solver::inelastic::ParticleDamage;
 use crate::solver::Simulation;

@@ -12,15 +12,13 @@
 //! arrays once: the cost is proportional to N, and a run without snapshots only tests an
 //! `Option` per step.
 
+use super::arrays::point3;
 use super::prepare::Prepared;
 use super::recover::Recovered;
-use super::summary::point3;
 use crate::solver::inelastic::ParticleDamage;
 use crate::solver::{Probe, Simulation};
 
-/// Bytes one frame holds per particle: displacement (3), stress (6) and the two damages
-/// (2), f64 each.
-pub const FRAME_BYTES_PER_PARTICLE: usize = (3 + 6 + 2) * 8;
+pub use super::model::FRAME_BYTES_PER_PARTICLE;
 
 /// One frame of a run's time series.
 #[derive(Clone, Debug)]

@@ -284,20 +284,7 @@ impl Outcome {
     }
 }
 
-/// A point of dimension D as a 3-vector (zeros beyond D).
-pub fn point3<const D: usize>(p: &nalgebra::SVector<f64, D>) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (o, v) in out.iter_mut().zip(p.iter()) {
-        *o = *v;
-    }
-    out
-}
-
-/// A symmetric D×D stress as 6 Voigt components [xx, yy, zz, yz, xz, xy] (zeros beyond D).
-pub fn voigt6<const D: usize>(s: &nalgebra::SMatrix<f64, D, D>) -> [f64; 6] {
-    let at = |r: usize, c: usize| if r < D && c < D { s[(r, c)] } else { 0.0 };
-    [at(0, 0), at(1, 1), at(2, 2), at(1, 2), at(0, 2), at(0, 1)]
-}
+pub use super::arrays::{point3, voigt6};
 
 /// What the relaxation solver adds to the summary (`None` for the explicit one).
 #[derive(Clone, Copy, Debug, Default)]

@@ -4,8 +4,9 @@
 use super::Axis;
 use serde::{Deserialize, Serialize};
 
-/// The most gauges a scene may have: each record carries their readings inline.
-pub const MAX_GAUGES: usize = crate::solver::gauge::MAX_GAUGES;
+/// The most gauges a scene may have: each record of a run carries their readings inline, so
+/// that a record stays a plain copyable value.
+pub const MAX_GAUGES: usize = 8;
 
 /// One gauge: the displacement of its second end less that of its first, along a
 /// direction. Each end is a group (the mean displacement of its particles) or a point (the

@@ -3,9 +3,7 @@
 
 use nalgebra::SVector;
 
-/// The most gauges a run reads: each [`super::Record`] carries their readings inline, so
-/// a record stays a plain copyable value.
-pub const MAX_GAUGES: usize = 8;
+pub use crate::scene::gauge::MAX_GAUGES;
 
 /// One gauge as weights on the particles' displacements: the opening is
 /// Σ w_i·(x_i − x0_i) over its terms.

@@ -99,6 +99,9 @@ fn run_writes_every_output() {
         format!("POINT_DATA {n}"),
         "SCALARS volume_m3 float 1".into(),
         "SCALARS id int 1".into(),
+        // in Pa, as the stress tensor
+        "SCALARS von_mises_Pa float 1".into(),
+        "SCALARS max_principal_Pa float 1".into(),
     ] {
         assert!(text.contains(&marker), "VTK lacks {marker}");
     }

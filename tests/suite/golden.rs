@@ -124,6 +124,36 @@ const GOLDEN: &[Golden] = &[
         steps: 127303,
         particles: 1060,
     },
+    // The 2D three-point bending beams, recorded when they were added (2 threads, default
+    // loading time of 60 periods; the random ones with seed 1).
+    Golden {
+        scene: "beam_3pb_notch02",
+        peak_force_n: 3751.4390983866433,
+        dissipated_energy_j: 0.21797204849979007,
+        steps: 30109,
+        particles: 6589,
+    },
+    Golden {
+        scene: "beam_3pb_unnotched",
+        peak_force_n: 5851.492267173659,
+        dissipated_energy_j: 0.2668632618099208,
+        steps: 26650,
+        particles: 6604,
+    },
+    Golden {
+        scene: "beam_3pb_notch02_random",
+        peak_force_n: 3714.8306792931717,
+        dissipated_energy_j: 0.16774885393052064,
+        steps: 31851,
+        particles: 6452,
+    },
+    Golden {
+        scene: "beam_3pb_unnotched_random",
+        peak_force_n: 5967.554322095569,
+        dissipated_energy_j: 0.11756377847609913,
+        steps: 20707,
+        particles: 6466,
+    },
 ];
 
 /// The number of a top-level key of summary.json, parsed by Rust's correctly rounded parser
@@ -369,4 +399,20 @@ fn golden_uniaxial_tension_random() {
 )]
 fn golden_uniaxial_tension_random_one_thread() {
     check("uniaxial_tension_random", "1");
+}
+
+#[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
+fn golden_bending_beams_2d() {
+    for scene in [
+        "beam_3pb_notch02",
+        "beam_3pb_unnotched",
+        "beam_3pb_notch02_random",
+        "beam_3pb_unnotched_random",
+    ] {
+        check(scene, "2");
+    }
 }

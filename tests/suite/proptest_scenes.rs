@@ -16,8 +16,9 @@ use toml::Value;
 
 /// The scene's sections: an error message names a key when it contains `section.` (or starts
 /// with `name =`), or carries the deserialiser's field or path (`field \`x\``, `in \`x.y\``).
-const SECTIONS: [&str; 11] = [
+const SECTIONS: [&str; 12] = [
     "body",
+    "gauges",
     "cutouts",
     "discretisation",
     "material",
