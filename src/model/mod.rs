@@ -1,5 +1,6 @@
 //! The SPLM/SPPM constitutive model: micro-moduli, stretch, force state, stress, strain,
 //! damage and plasticity, in 2D and 3D (`dimension`: dimension as a type).
+pub mod bond_based;
 pub mod damage;
 pub mod damage_law;
 pub mod dimension;
