@@ -158,11 +158,11 @@ mod tests {
         count
     }
 
-    /// The stencil holds every lattice point within δ = m·Δx (122 at m = π: the issue's
-    /// "about 120 bonds"). The thesis's partial volumes count no neighbour beyond δ and only
-    /// half a cell at δ, so the family volume falls short of the sphere's 4/3·πδ³ by about
-    /// the half-cell shell left out, 4πδ²·(Δx/2)·¼ / (4/3·πδ³) = 3Δx/(8δ): within a factor of
-    /// two of it at m = π … 2π (the lattice's own scatter on top).
+    /// The stencil holds every lattice point within δ = m·Δx (122 at m = π). The thesis's
+    /// partial volumes count no neighbour beyond δ and only half a cell at δ, so the family
+    /// volume falls short of the sphere's 4/3·πδ³ by about the half-cell shell left out,
+    /// 4πδ²·(Δx/2)·¼ / (4/3·πδ³) = 3Δx/(8δ): within a factor of two of it at m = π … 2π
+    /// (the lattice's own scatter on top).
     #[test]
     fn the_stencil_is_the_ball_and_its_volume_lacks_a_half_cell_shell() {
         let dx = 0.005;
