@@ -65,8 +65,8 @@ fn scalar_of(
     if dim == 2 {
         in_plane(&nalgebra::Matrix2::new(s[0], s[5], s[5], s[1]))
     } else {
-        solid(&nalgebra::Matrix3::new(
-            s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2],
+        solid(&nalgebra::Matrix3::from_row_slice(
+            &crate::run::arrays::tensor9(s),
         ))
     }
 }

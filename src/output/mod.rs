@@ -140,12 +140,22 @@ pub fn write_summary(outcome: &Outcome, dir: &Path) -> anyhow::Result<()> {
 /// in `keep`.
 fn remove_stale(dir: &Path, keep: &[PathBuf]) -> anyhow::Result<()> {
     let entries = std::fs::read_dir(dir).map_err(|e| fsio::IoFailure::new("list", dir, e))?;
+    remove_unkept(entries, keep, is_run_file)
+}
+
+/// Remove the files of `entries` that sppm writes (`ours`, or a temporary file of an
+/// interrupted write of one) and that are not in `keep`.
+pub(crate) fn remove_unkept(
+    entries: std::fs::ReadDir,
+    keep: &[PathBuf],
+    ours: fn(&str) -> bool,
+) -> anyhow::Result<()> {
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
         let partial = name.starts_with('.')
             && name.ends_with(".partial")
-            && is_run_file(&name[1..name.len() - ".partial".len()]);
-        if (is_run_file(&name) || partial) && !keep.contains(&entry.path()) {
+            && ours(&name[1..name.len() - ".partial".len()]);
+        if (ours(&name) || partial) && !keep.contains(&entry.path()) {
             let p = entry.path();
             std::fs::remove_file(&p)
                 .map_err(|e| fsio::IoFailure::new("remove the stale", &p, e))?;

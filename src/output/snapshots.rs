@@ -63,7 +63,7 @@ fn write_frame(o: &Outcome, f: &Snapshot, id: &[i32], path: &Path) -> anyhow::Re
     let stress: Vec<f64> = f
         .stress
         .iter()
-        .flat_map(|s| [s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2]])
+        .flat_map(crate::run::arrays::tensor9)
         .collect();
     let von_mises: Vec<f64> = f
         .stress
@@ -137,17 +137,7 @@ pub fn remove_stale_frames(dir: &Path, keep: &[PathBuf]) -> anyhow::Result<()> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
         Err(e) => return Err(fsio::IoFailure::new("list", &folder, e).into()),
     };
-    for entry in entries.flatten() {
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let partial = name.starts_with('.')
-            && name.ends_with(".partial")
-            && is_frame_file(&name[1..name.len() - ".partial".len()]);
-        if (is_frame_file(&name) || partial) && !keep.contains(&entry.path()) {
-            let p = entry.path();
-            std::fs::remove_file(&p)
-                .map_err(|e| fsio::IoFailure::new("remove the stale", &p, e))?;
-        }
-    }
+    super::remove_unkept(entries, keep, is_frame_file)?;
     if keep.is_empty() {
         // only when empty: a file of the user's stays, and so does its folder
         let _ = std::fs::remove_dir(&folder);

@@ -46,7 +46,7 @@ pub fn write_particles(o: &Outcome, path: &Path) -> anyhow::Result<()> {
     writeln!(w, "\nTENSORS stress_Pa float")?;
     for s in &o.stress {
         // Voigt [xx, yy, zz, yz, xz, xy] to the row-major 3×3 tensor
-        for v in [s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2]] {
+        for v in crate::run::arrays::tensor9(s) {
             be(&mut w, v)?;
         }
     }

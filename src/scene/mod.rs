@@ -536,7 +536,7 @@ impl Scene {
             .map_err(|e| SceneError::Parse(e.to_string()))?;
         scene.validate_geometry()?;
         scene.resolve()?;
-        scene.validate()?;
+        scene.validate_resolved()?;
         Ok(scene)
     }
 

@@ -191,32 +191,31 @@ impl Scene {
             Some(_) => (&CONCRETE_E, &CONCRETE_RHO),
             None => (&SOLID_E, &SOLID_RHO),
         };
-        let mut inputs: Vec<(&str, Option<f64>, &Quantity)> =
-            vec![("material.E", self.material.e, e)];
-        inputs.push(("material.rho", Some(self.material.rho), rho));
+        let mut inputs: Vec<(String, Option<f64>, &Quantity)> = vec![
+            ("material.E".into(), self.material.e, e),
+            ("material.rho".into(), Some(self.material.rho), rho),
+        ];
         if let Some(c) = concrete {
-            inputs.extend([
-                ("concrete.fc", c.fc, &CONCRETE_FC),
-                ("concrete.ft", c.ft, &CONCRETE_FT),
-                ("concrete.fy", c.fy, &CONCRETE_FC),
-                ("concrete.fult", c.fult, &CONCRETE_FC),
-                ("concrete.Gf", c.gf, &CONCRETE_GF),
-                ("concrete.Gf0", c.gf0, &CONCRETE_GF0),
-            ]);
+            for (key, value, q) in [
+                ("fc", c.fc, &CONCRETE_FC),
+                ("ft", c.ft, &CONCRETE_FT),
+                ("fy", c.fy, &CONCRETE_FC),
+                ("fult", c.fult, &CONCRETE_FC),
+                ("Gf", c.gf, &CONCRETE_GF),
+                ("Gf0", c.gf0, &CONCRETE_GF0),
+            ] {
+                inputs.push((format!("concrete.{key}"), value, q));
+            }
         }
         // a random field's mean is the same quantity as its property
-        let (solid_e, fields) = (e, &self.random_field);
-        let field_keys: Vec<String> = (0..fields.len())
-            .map(|k| format!("random_field[{k}].mean"))
-            .collect();
-        for (f, key) in fields.iter().zip(&field_keys) {
+        for (k, f) in self.random_field.iter().enumerate() {
             let q = match f.property {
-                super::FieldProperty::E => solid_e,
+                super::FieldProperty::E => e,
                 super::FieldProperty::Ft => &CONCRETE_FT,
                 super::FieldProperty::Gf => &CONCRETE_GF,
                 super::FieldProperty::Fc => &CONCRETE_FC,
             };
-            inputs.push((key.as_str(), f.mean, q));
+            inputs.push((format!("random_field[{k}].mean"), f.mean, q));
         }
         let mut warnings = Vec::new();
         for (key, value, q) in inputs {
@@ -224,7 +223,7 @@ impl Scene {
             let Some(v) = value.filter(|v| v.is_finite() && *v > 0.0) else {
                 continue;
             };
-            warnings.extend(q.judge(key, v)?);
+            warnings.extend(q.judge(&key, v)?);
         }
         self.warnings = warnings;
         Ok(())

@@ -113,10 +113,24 @@ pub fn crack_path(
     threshold: f64,
     clear: &Clearance,
 ) -> Result<CrackPath, NoCrack> {
+    fit(x0, wt, threshold, clear, |pts| pts)
+}
+
+/// The principal line of the points `kept` keeps of the damaged particles on the path, or
+/// the counts of why there is none.
+fn fit(
+    x0: &[Vector2<f64>],
+    wt: &[f64],
+    threshold: f64,
+    clear: &Clearance,
+    kept: fn(Vec<Vector2<f64>>) -> Vec<Vector2<f64>>,
+) -> Result<CrackPath, NoCrack> {
     let (pts, damaged) = on_path(x0, wt, threshold, clear);
+    let near_groups = damaged - pts.len();
+    let pts = kept(pts);
     principal_line(&pts).ok_or(NoCrack {
         damaged,
-        near_groups: damaged - pts.len(),
+        near_groups,
         fitted: pts.len(),
     })
 }
@@ -166,12 +180,7 @@ pub fn crack_core(
     threshold: f64,
     clear: &Clearance,
 ) -> Result<CrackPath, NoCrack> {
-    let (pts, damaged) = on_path(x0, wt, threshold, clear);
-    core_line(&pts).ok_or(NoCrack {
-        damaged,
-        near_groups: damaged - pts.len(),
-        fitted: core_points(&pts).len(),
-    })
+    fit(x0, wt, threshold, clear, |pts| core_points(&pts))
 }
 
 /// The principal line of the points in the middle half of a point set's extent along its

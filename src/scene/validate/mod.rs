@@ -116,6 +116,12 @@ impl Scene {
     /// Check every value, table by table; the first problem found is returned.
     pub fn validate(&self) -> Result<(), SceneError> {
         self.validate_geometry()?;
+        self.validate_resolved()
+    }
+
+    /// The tables after the geometry, which need the resolved material values;
+    /// [`Scene::from_toml_str`] runs it after [`Scene::resolve`].
+    pub(crate) fn validate_resolved(&self) -> Result<(), SceneError> {
         super::random_fields::check(self)?;
         self.validate_material()?;
         self.validate_groups()?;

@@ -21,11 +21,19 @@ pub const DOGBONE_SIZES: [(char, f64); 6] = [
 
 /// The scaling rule of the size variant, the one text the documentation, `--help` and
 /// size_effect.json state it in.
+macro_rules! displacement_rule {
+    () => {
+        "every loaded group's displacement × √(D/D0)"
+    };
+}
 macro_rules! spacing_rule {
     () => {
-        "body.size = D; discretisation.spacing = s0·min(1, D/D0); every loaded group's \
-         displacement × √(D/D0); with the relaxation solver, solver.max_iterations × \
-         max(1, D/D0) (D0, s0: the scene's size and spacing)"
+        concat!(
+            "body.size = D; discretisation.spacing = s0·min(1, D/D0); ",
+            displacement_rule!(),
+            "; with the relaxation solver, solver.max_iterations × max(1, D/D0) (D0, s0: the \
+             scene's size and spacing)"
+        )
     };
 }
 
@@ -33,7 +41,7 @@ macro_rules! spacing_rule {
 pub const SPACING_RULE: &str = spacing_rule!();
 
 /// How the loaded groups' displacement scales with the size: a part of [`SPACING_RULE`].
-pub const DISPLACEMENT_RULE: &str = "every loaded group's displacement × √(D/D0)";
+pub const DISPLACEMENT_RULE: &str = displacement_rule!();
 
 /// The paragraph of `sppm study montecarlo --help` that states [`SPACING_RULE`].
 pub const SIZE_VARIANT_HELP: &str = concat!(
