@@ -3,7 +3,7 @@
 //! for. Adding a discretisation is a generator module (`run::generate`), an arm of
 //! [`Discretisation`] and one line here.
 
-use super::generate::{Fcc, Generator, Hexagonal, RandomPlane, RandomSolid};
+use super::generate::{CubicGrid, Fcc, Generator, Hexagonal, RandomPlane, RandomSolid, SquareGrid};
 use super::model::memory_in_slots;
 use super::recover::Recover;
 use crate::model::dimension::{Dim, Dimension};
@@ -27,6 +27,8 @@ pub fn dispatch<T: TypedRun>(scene: &Scene, work: T) -> T::Output {
         Discretisation::RandomPlane => work.run(scene, RandomPlane::default()),
         Discretisation::Fcc => work.run(scene, Fcc),
         Discretisation::RandomSolid => work.run(scene, RandomSolid),
+        Discretisation::CubicGrid => work.run(scene, CubicGrid),
+        Discretisation::SquareGrid => work.run(scene, SquareGrid),
     }
 }
 

@@ -73,7 +73,8 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Outcome, RunError> {
     pool.install(|| dispatch(scene, Execute { opts, threads }))
 }
 
-/// A run of a scene with its generator.
+/// A run of a scene with its generator: the family of `[model]` decides how the points are
+/// bonded and integrated.
 struct Execute<'a> {
     opts: &'a RunOptions,
     threads: usize,
@@ -87,6 +88,9 @@ impl TypedRun for Execute<'_> {
         G: Generator<D, K>,
         Dim<D>: Dimension<D> + Recover<D>,
     {
+        if scene.model.is_bond_based() {
+            return super::bond_based::run_bond_based(scene, generator, self.opts, self.threads);
+        }
         let p = prepare(scene, generator)?;
         run_prepared(
             p,

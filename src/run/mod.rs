@@ -12,6 +12,7 @@
 //! the studies are thin callers.
 
 pub mod arrays;
+pub mod bond_based;
 pub mod check;
 pub mod dispatch;
 pub mod execute;

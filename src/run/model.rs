@@ -114,6 +114,12 @@ impl<const K: usize, const D: usize> Model<K, D> {
 /// before anything is allocated.
 pub fn estimated_particles(scene: &Scene) -> f64 {
     let l0 = scene.discretisation.spacing;
+    if scene.discretisation.lattice == crate::scene::Lattice::Cubic {
+        return match scene.solid() {
+            Some(solid) => solid.volume() / l0.powi(3),
+            None => scene.shape().area() / (l0 * l0),
+        };
+    }
     if let Some(solid) = scene.solid() {
         return solid.volume() / crate::discretise::fcc::cell_volume(l0);
     }

@@ -166,61 +166,10 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
     stage("stable time step (largest frequency, Lanczos)");
     let mut stable = stable_step(&model.mech, &model.particles.x0);
     stable.implicit_share = share;
-    let dt = match scene.solver.dt {
-        Some(dt) if dt > stable.dt_stable => {
-            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
-                key: "solver.dt".into(),
-                value: format!("{dt:e}"),
-                allowed: format!(
-                    "at most the stable limit {:.6e} s computed from the stiffness, masses and damping (or leave solver.dt out to use solver.safety × the limit)",
-                    stable.dt_stable
-                ),
-            }))
-        }
-        Some(dt) => dt,
-        None => scene.solver.safety * stable.dt_stable,
-    };
-    let t_end = match (scene.loading.end_periods, scene.loading.end_s) {
-        (Some(p), _) => p * fundamental.period,
-        (None, Some(s)) => s,
-        (None, None) => crate::scene::DEFAULT_END_PERIODS * fundamental.period,
-    };
-    let steps = (t_end / dt).ceil() as usize;
-    if steps as f64 * n as f64 > 1e14 {
-        return Err(RunError::Setup(format!(
-            "loading: t_end = {t_end:.3e} s needs {steps} steps of {n} particles, beyond 1e14 particle-steps; shorten loading.end_periods or coarsen discretisation.spacing"
-        )));
-    }
-
-    let probe_name = scene.output.probe_group.clone().or_else(|| {
-        scene
-            .groups
-            .iter()
-            .find(|g| g.load.is_some())
-            .map(|g| g.name.clone())
-    });
-    let probe = probe_name.map(|name| {
-        let spec = scene.groups.iter().find(|g| g.name == name).unwrap();
-        let members = model
-            .groups
-            .iter()
-            .find(|g| g.name == name)
-            .unwrap()
-            .members
-            .clone();
-        let (component, amplitude) = match &spec.load {
-            Some(l) => (l.component.index(), l.delta()),
-            None => (spec.fix[0].index(), 0.0),
-        };
-        (
-            name,
-            Probe {
-                members,
-                component,
-                amplitude,
-            },
-        )
-    });
+    let dt = time_step(scene, stable.dt_stable)?;
+    let t_end = loading_time(scene, fundamental.period);
+    let steps = checked_steps(t_end, dt, n)?;
+    let probe = probe_of(scene, &model.groups);
 
     Ok(Prepared {
         model,
@@ -256,4 +205,69 @@ fn scaled<const K: usize, const D: usize>(
         }));
     }
     Ok(r)
+}
+
+/// The run's end t_end (s): `loading.end_periods` × T1, or `loading.end_s`, or
+/// [`crate::scene::DEFAULT_END_PERIODS`] × T1.
+pub(crate) fn loading_time(scene: &Scene, period: f64) -> f64 {
+    match (scene.loading.end_periods, scene.loading.end_s) {
+        (Some(p), _) => p * period,
+        (None, Some(s)) => s,
+        (None, None) => crate::scene::DEFAULT_END_PERIODS * period,
+    }
+}
+
+/// The steps of Δt to t_end, refused beyond 1e14 particle-steps of `n` particles.
+pub(crate) fn checked_steps(t_end: f64, dt: f64, n: usize) -> Result<usize, RunError> {
+    let steps = (t_end / dt).ceil() as usize;
+    if steps as f64 * n as f64 > 1e14 {
+        return Err(RunError::Setup(format!(
+            "loading: t_end = {t_end:.3e} s needs {steps} steps of {n} particles, beyond 1e14 particle-steps; shorten loading.end_periods or coarsen discretisation.spacing"
+        )));
+    }
+    Ok(steps)
+}
+
+/// The probe of a run: `output.probe_group`, else the first loaded group, with the component
+/// and Δmax along which its reaction is read.
+pub(crate) fn probe_of(
+    scene: &Scene,
+    groups: &[crate::discretise::groups::Group],
+) -> Option<(String, Probe)> {
+    let name = scene.output.probe_group.clone().or_else(|| {
+        scene
+            .groups
+            .iter()
+            .find(|g| g.load.is_some())
+            .map(|g| g.name.clone())
+    })?;
+    let spec = scene.groups.iter().find(|g| g.name == name)?;
+    let members = groups.iter().find(|g| g.name == name)?.members.clone();
+    let (component, amplitude) = match &spec.load {
+        Some(l) => (l.component.index(), l.delta()),
+        None => (spec.fix[0].index(), 0.0),
+    };
+    Some((
+        name,
+        Probe {
+            members,
+            component,
+            amplitude,
+        },
+    ))
+}
+
+/// The run's Δt: `solver.dt`, refused above the stable limit, or `solver.safety` × the limit.
+pub(crate) fn time_step(scene: &Scene, dt_stable: f64) -> Result<f64, RunError> {
+    match scene.solver.dt {
+        Some(dt) if dt > dt_stable => Err(RunError::Scene(crate::scene::SceneError::Invalid {
+            key: "solver.dt".into(),
+            value: format!("{dt:e}"),
+            allowed: format!(
+                "at most the stable limit {dt_stable:.6e} s computed from the stiffness, masses and damping (or leave solver.dt out to use solver.safety × the limit)"
+            ),
+        })),
+        Some(dt) => Ok(dt),
+        None => Ok(scene.solver.safety * dt_stable),
+    }
 }

@@ -105,6 +105,10 @@ pub struct Summary {
     /// The step kernel chosen for the scene's features: elastic, tension or full.
     pub kernel: crate::solver::KernelSet,
     pub surface_correction: SurfaceCorrection,
+    /// The bond-based family (`model.family = "bond_based"`): its horizon, micromodulus,
+    /// law and bonds; absent for the state-based lattice.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bond_based: Option<super::bond_based::BondReport>,
     /// Random particles (SPPM): generation (count, distances, bond histogram, times), the
     /// minimum distance, and the micro-moduli residual statistics; absent for lattices.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -462,6 +466,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         force_lag: p.model.scene.solver.force_lag,
         kernel,
         surface_correction: p.model.surface.clone(),
+        bond_based: None,
         random_particles: p.model.random.as_ref().map(|r| RandomReport {
             generation: r.generation.clone(),
             micro_moduli: r.moduli.clone(),

@@ -47,6 +47,9 @@ pub enum Lattice {
     Fcc,
     /// Random Voronoi-weighted particles (SPPM), in a 2D shape or a solid.
     Random,
+    /// The regular grid of the bond-based family: points at the centres of cubic cells of
+    /// side `spacing` in a solid, of square cells in a 2D shape.
+    Cubic,
 }
 
 impl Lattice {
@@ -56,6 +59,7 @@ impl Lattice {
             Lattice::Hexagonal => "hexagonal",
             Lattice::Fcc => "fcc",
             Lattice::Random => "random",
+            Lattice::Cubic => "cubic",
         }
     }
 }
@@ -73,14 +77,20 @@ pub enum Discretisation {
     Fcc,
     /// Random particles in a solid.
     RandomSolid,
+    /// The cubic grid in a solid (bond-based family only).
+    CubicGrid,
+    /// The square grid in a 2D shape (bond-based family only).
+    SquareGrid,
 }
 
 impl Discretisation {
     /// The spatial dimension of its runs.
     pub fn dim(self) -> usize {
         match self {
-            Discretisation::Hexagonal | Discretisation::RandomPlane => 2,
-            Discretisation::Fcc | Discretisation::RandomSolid => 3,
+            Discretisation::Hexagonal
+            | Discretisation::RandomPlane
+            | Discretisation::SquareGrid => 2,
+            Discretisation::Fcc | Discretisation::RandomSolid | Discretisation::CubicGrid => 3,
         }
     }
 

@@ -8,6 +8,7 @@ pub mod concrete;
 mod discretisation;
 pub mod gauge;
 mod loading;
+pub mod model_family;
 mod overrides;
 mod plausible;
 pub mod random_fields;
@@ -20,6 +21,7 @@ pub use discretisation::{Discretisation, DiscretisationSpec, Lattice, Rotation, 
 pub use loading::{
     BondScheme, DampingSpec, LoadSpec, LoadingSpec, Pace, Ramp, DEFAULT_END_PERIODS, KINETIC_LIMIT,
 };
+pub use model_family::{Family, ModelSpec};
 pub use overrides::apply_overrides;
 pub use solver_settings::{ControlSpec, ForceLag, SolverMethod, SolverSpec};
 pub use validate::SceneError;
@@ -62,6 +64,10 @@ pub struct Scene {
     pub damping: DampingSpec,
     #[serde(default)]
     pub solver: SolverSpec,
+    /// The model family and the bond-based model's choices (`[model]`; default the
+    /// state-based lattice).
+    #[serde(default)]
+    pub model: ModelSpec,
     #[serde(default)]
     pub output: OutputSpec,
     /// Openings measured during the run (`[[gauges]]`): CMOD, LVDTs.
@@ -511,6 +517,8 @@ impl Scene {
             (Lattice::Random, true) => Discretisation::RandomSolid,
             (Lattice::Random, false) => Discretisation::RandomPlane,
             (Lattice::Hexagonal, _) => Discretisation::Hexagonal,
+            (Lattice::Cubic, true) => Discretisation::CubicGrid,
+            (Lattice::Cubic, false) => Discretisation::SquareGrid,
         }
     }
 

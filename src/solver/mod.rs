@@ -48,6 +48,9 @@ pub enum KernelSet {
     Elastic,
     Tension,
     Full,
+    /// The bond-based family's kernel (`model::bond_based::kernel`).
+    #[serde(rename = "bond_based")]
+    BondBased,
 }
 
 impl KernelSet {
@@ -56,6 +59,7 @@ impl KernelSet {
             KernelSet::Elastic => "elastic",
             KernelSet::Tension => "tension",
             KernelSet::Full => "full",
+            KernelSet::BondBased => "bond_based",
         }
     }
 }

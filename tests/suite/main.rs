@@ -3,6 +3,7 @@
 //! (`cargo test --release --features validation`, which CI runs after the fast suite).
 
 mod bending;
+mod bond_based;
 mod cli;
 #[path = "../common/mod.rs"]
 mod common;

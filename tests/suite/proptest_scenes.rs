@@ -16,7 +16,8 @@ use toml::Value;
 
 /// The scene's sections: an error message names a key when it contains `section.` (or starts
 /// with `name =`), or carries the deserialiser's field or path (`field \`x\``, `in \`x.y\``).
-const SECTIONS: [&str; 12] = [
+const SECTIONS: [&str; 13] = [
+    "model",
     "body",
     "gauges",
     "cutouts",

@@ -466,3 +466,52 @@ fn a_body_too_small_for_random_particles_is_refused() {
     };
     says(&msg, &["discretisation.spacing"]);
 }
+
+/// `[model]`: the bond-based keys only with the bond-based family, their ranges, the cubic
+/// grid only with it, and what a bond-based run does not offer, each under the key the scene
+/// set.
+#[test]
+fn model_family_keys() {
+    says(
+        &error_of(&["model.horizon=3.0"]),
+        &["model.horizon = set", "model.family = \"bond_based\""],
+    );
+    says(
+        &error_of(&["discretisation.lattice=cubic"]),
+        &["discretisation.lattice = \"cubic\"", "bond_based"],
+    );
+    let bb = "model.family=bond_based";
+    assert!(Scene::from_toml_str(BASE, &[bb.to_string()]).is_ok());
+    says(
+        &error_of(&[bb, "model.horizon=12"]),
+        &["model.horizon = 12", "from 1.5 to 8"],
+    );
+    says(
+        &error_of(&[bb, "model.compressive_stretch=-0.001"]),
+        &["model.compressive_stretch = -0.001", "positive"],
+    );
+    says(
+        &error_of(&[bb, "model.softening=trilinear"]),
+        &["model.softening = \"trilinear\"", "[concrete]"],
+    );
+    says(
+        &error_of(&[bb, "model.softening=quadratic"]),
+        &["unknown variant `quadratic`", "non_linear"],
+    );
+    says(
+        &error_of(&[bb, "solver.method=relaxation"]),
+        &[
+            "solver.method = \"relaxation\"",
+            "\"explicit\"",
+            "bond_based",
+        ],
+    );
+    says(
+        &error_of(&[bb, "damping.internal=0.1"]),
+        &["damping.internal = 0.1", "damping.external"],
+    );
+    says(
+        &error_of(&[bb, "output.snapshots=4"]),
+        &["output.snapshots = 4", "absent with model.family"],
+    );
+}

@@ -41,15 +41,19 @@ pub struct Fit {
     pub gf: f64,
     /// Horizon δ (m).
     pub delta: f64,
-    /// Micromodulus c (N/m⁶), [`super::micromodulus`].
+    /// Micromodulus c (N/m⁶ in 3D, N/m⁵ in a plate), [`super::micromodulus`].
     pub c: f64,
+    /// The plate's thickness t (m) of a 2D body; `None` in 3D.
+    pub thickness: Option<f64>,
 }
 
-/// The fracture energy a 3D body of constant micromodulus c and horizon δ dissipates when
-/// every bond that crosses a plane dissipates w per unit ξ·(volume)²: π·c·δ⁵/5 × the area
-/// under c⁻¹·f(s) (B.5).
+/// The fracture energy of a body of constant micromodulus c and horizon δ per unit area
+/// under c⁻¹·f(s): π·c·δ⁵/5 in 3D (B.5), c·t·δ⁴/2 in a plate of thickness t (B.6).
 fn energy_factor(f: &Fit) -> f64 {
-    PI * f.c * f.delta.powi(5) / 5.0
+    match f.thickness {
+        None => PI * f.c * f.delta.powi(5) / 5.0,
+        Some(t) => f.c * t * f.delta.powi(4) / 2.0,
+    }
 }
 
 impl Softening {
@@ -91,6 +95,44 @@ impl Softening {
         let q = 2.0 * k - 2.0 * ek + alpha * k - alpha * k * ek + 2.0;
         let sc = s0 + 2.0 * k * (ek - 1.0) * (1.0 + alpha) * f.gf / (energy_factor(f) * s0 * -q);
         Softening::NonLinear { s0, sc, k, alpha }
+    }
+
+    /// The law fitted to the micromodulus λ·c instead of c (Hobbs's critical-stretch
+    /// correction of surface bonds): the stretches the energy fixes scale as 1/√λ (linear,
+    /// bilinear), the softening branch beyond s0 = f_t/E as 1/λ (trilinear, non-linear), so
+    /// that the bond dissipates the same energy with its corrected stiffness.
+    pub fn for_stiffness(&self, lambda: f64) -> Self {
+        match *self {
+            Softening::Linear { sc } => Softening::Linear {
+                sc: sc / lambda.sqrt(),
+            },
+            Softening::Bilinear { s0, sc } => Softening::Bilinear {
+                s0: s0 / lambda.sqrt(),
+                sc: sc / lambda.sqrt(),
+            },
+            Softening::Trilinear { s0, s1, sc, beta } => Softening::Trilinear {
+                s0,
+                s1: s0 + (s1 - s0) / lambda,
+                sc: s0 + (sc - s0) / lambda,
+                beta,
+            },
+            Softening::NonLinear { s0, sc, k, alpha } => Softening::NonLinear {
+                s0,
+                sc: s0 + (sc - s0) / lambda,
+                k,
+                alpha,
+            },
+        }
+    }
+
+    /// The stretch up to which the bond is elastic (s_c for the linear law).
+    pub fn elastic_limit(&self) -> f64 {
+        match *self {
+            Softening::Linear { sc } => sc,
+            Softening::Bilinear { s0, .. }
+            | Softening::Trilinear { s0, .. }
+            | Softening::NonLinear { s0, .. } => s0,
+        }
     }
 
     /// The critical stretch, beyond which the bond carries nothing.
@@ -160,6 +202,7 @@ mod tests {
             gf: 143.2,
             delta,
             c: micromodulus(e, delta, Body::Solid, Influence::Constant),
+            thickness: None,
         }
     }
 
@@ -269,6 +312,55 @@ mod tests {
         };
         let excess = dissipated(&law, &f) / f.gf - 1.0;
         assert!(excess > 0.003 && excess < 0.004, "{excess}");
+    }
+
+    /// Refitted to a surface bond's micromodulus λ·c (the critical-stretch correction), every
+    /// law dissipates G_F again with the stiffer bond (to the quadrature's accuracy).
+    #[test]
+    fn a_law_refitted_to_a_stiffer_bond_dissipates_the_same_energy() {
+        let f = gregoire();
+        for lambda in [0.6, 1.7, 3.2] {
+            let stiffer = Fit {
+                c: lambda * f.c,
+                ..f
+            };
+            for law in [
+                Softening::linear(&f),
+                Softening::bilinear(&f, 25.0),
+                Softening::trilinear(&f, 0.25),
+                Softening::non_linear(&f, 25.0, 0.25),
+            ] {
+                let refit = law.for_stiffness(lambda);
+                within(
+                    &format!("{refit:?}"),
+                    dissipated(&refit, &stiffer),
+                    f.gf,
+                    1e-6,
+                );
+            }
+        }
+    }
+
+    /// In a plate (plane stress, thickness t) the linear law's critical stretch is the
+    /// closed form √(4π·G_F/(9·E·δ)) of Ha & Bobaru (2010) with c = 9E/(π·t·δ³).
+    #[test]
+    fn the_plate_critical_stretch_is_the_closed_form() {
+        let (e, delta, t, gf) = (30e9, 0.006, 0.05, 100.0);
+        let f = Fit {
+            e,
+            ft: 3e6,
+            gf,
+            delta,
+            c: micromodulus(e, delta, Body::PlaneStress { t }, Influence::Constant),
+            thickness: Some(t),
+        };
+        let want = (4.0 * PI * gf / (9.0 * e * delta)).sqrt();
+        within(
+            "plate s_c",
+            Softening::linear(&f).critical_stretch(),
+            want,
+            1e-12,
+        );
     }
 
     /// The laws start to soften at s0 (no damage below, the elastic force there) and carry

@@ -5,6 +5,7 @@
 //! `scene::Discretisation` and one line of `run::dispatch`.
 
 mod fcc;
+mod grid;
 mod hexagonal;
 pub mod moduli;
 mod plane;
@@ -13,6 +14,7 @@ mod random_solid;
 mod solid;
 
 pub use fcc::{fcc_body, surface_treatment as fcc_surface_treatment, Fcc, SolidBody};
+pub use grid::{CubicGrid, SquareGrid};
 pub use hexagonal::Hexagonal;
 pub use random_plane::RandomPlane;
 pub use random_solid::RandomSolid;

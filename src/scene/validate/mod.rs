@@ -9,6 +9,7 @@ mod gauges;
 mod groups;
 mod loading;
 mod material;
+mod model;
 mod output;
 mod solver;
 
@@ -128,6 +129,7 @@ impl Scene {
         self.validate_loading()?;
         self.validate_damping()?;
         self.validate_solver()?;
+        self.validate_model()?;
         self.validate_output()?;
         self.validate_gauges()
     }
