@@ -311,6 +311,14 @@ where
     summary.max_compressive_damage = None;
     summary.micro_modulus_a_bulk = 0.0;
     summary.micro_modulus_b_bulk = 0.0;
+    if (scene.material.nu - report.poisson_ratio_of_the_model).abs() > 1e-3 {
+        summary.warnings.push(format!(
+            "material.nu = {}: the bond-based model fixes Poisson's ratio at {:.4} in this body ({}); the run uses material.E and not material.nu",
+            scene.material.nu,
+            report.poisson_ratio_of_the_model,
+            if D == 3 { "3D" } else { "a plate" }
+        ));
+    }
     summary.bond_based = Some(report);
     let x0 = &p.model.particles.x0;
     let stress = stepper.stresses();

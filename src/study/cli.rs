@@ -84,6 +84,19 @@ pub enum StudyCommand {
         #[command(flatten)]
         common: StudyOptions,
     },
+    /// Run one specimen under each model family, side by side: the scene as written (SPLM),
+    /// its body in random particles (SPPM, lattice scenes only) and the bond-based model on the
+    /// scene's own particles (output/<scene>-families/families.csv, a row per family written
+    /// as it finishes; the same command resumes).
+    Families {
+        scene: PathBuf,
+        /// Override a scene value in every run (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Study folder (default: output/<scene file stem>-families).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Combine the shard folders of one Monte Carlo study: realisations.csv,
     /// deterministic.csv and the size-effect report in --out.
     Merge {
@@ -235,6 +248,20 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
             }
             no_data(&empty, "realisations.csv");
             Ok(status(report.completed, report.runs))
+        }
+        StudyCommand::Families { scene, set, out } => {
+            let out = out.unwrap_or_else(|| super::families::default_out(&scene));
+            let rows = super::families::families(&scene, &set, &out)?;
+            for r in &rows {
+                crate::say!("{r}");
+            }
+            crate::say!("wrote {}", out.join("families.csv").display());
+            let failed = rows
+                .iter()
+                .skip(1)
+                .filter(|r| r.contains(",failed,"))
+                .count();
+            Ok(status(rows.len() - 1 - failed, rows.len() - 1))
         }
         StudyCommand::Merge { dirs, out, partial } => {
             let merged = merge(&dirs, out, partial)?;

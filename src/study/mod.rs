@@ -16,9 +16,11 @@
 pub mod angle_effect;
 pub mod cli;
 pub mod convergence;
+pub mod crack_kink;
 pub mod crack_path;
 pub mod elastic_checks;
 pub mod extrapolation;
+pub mod families;
 pub mod monte_carlo;
 pub mod objectivity;
 pub mod options;

@@ -95,3 +95,103 @@ fn the_gregoire_beams_reach_the_thesis_peaks() {
         }
     }
 }
+
+/// The kinks at the two tips of the centre-cracked slab's preset crack, measured on the
+/// points with φ ≥ 0.35 within 2δ of each tip.
+fn slab_kinks(beta: f64) -> [f64; 2] {
+    use nalgebra::Vector2;
+    let path = format!(
+        "{}/lattices/slab_centre_crack_{beta}_bond_based.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let scene = sppm::Scene::from_file(std::path::Path::new(&path), &[]).unwrap();
+    let o = sppm::run::run(&scene, &sppm::run::RunOptions::default()).unwrap();
+    let delta = o.summary.bond_based.as_ref().unwrap().horizon_m;
+    let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
+    let phi: Vec<f64> = o.damage.as_ref().unwrap().iter().map(|d| d.wt).collect();
+    let b = beta.to_radians();
+    let half = Vector2::new(b.cos(), b.sin()) * 0.02;
+    let centre = Vector2::new(0.25, 0.2);
+    let got = sppm::study::crack_kink::kinks(
+        &x0,
+        &phi,
+        (centre - half, centre + half),
+        sppm::study::families::BOND_CRACK_DAMAGE,
+        (0.0, 2.0 * delta),
+    );
+    got.map(|k| k.expect("a crack from each tip").angle_deg)
+}
+
+/// The centre-cracked slab of the extended model of concrete (Δx = 2.5 mm, δ = 10 mm): a
+/// crack normal to the pull grows straight on from both tips (maximum tangential stress
+/// theory: 0°, within 5°); a crack at 45° turns towards the normal of the pull, between the
+/// far field's 45° and the theory's initial 53.1° (within 5° of either end). The theory's
+/// 53.1° itself is not met at one tip (benchmarks/RESULTS.md, "Bond-based centre-cracked
+/// slab").
+#[test]
+#[cfg_attr(
+    not(feature = "validation"),
+    ignore = "validation: cargo test --release --features validation"
+)]
+fn the_slab_crack_grows_straight_in_mode_one_and_turns_in_mixed_mode() {
+    for k in slab_kinks(90.0) {
+        assert!(k <= 5.0, "mode I kink {k:.1}°");
+    }
+    for k in slab_kinks(45.0) {
+        assert!((40.0..=58.1).contains(&k), "mixed-mode kink {k:.1}°");
+    }
+}
+
+/// `sppm study families` writes a row per family as it finishes (SPLM, SPPM, bond-based on
+/// the scene's particles), and run again it runs nothing that finished but retries a row
+/// that failed.
+#[test]
+fn the_families_study_writes_each_row_and_resumes() {
+    let dir = std::env::temp_dir().join(format!("sppm-families-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let args = [
+        "study",
+        "families",
+        "lattices/uniaxial_tension.toml",
+        "--set",
+        "discretisation.spacing=0.01",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    let out = common::sppm(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = dir.join("families.csv");
+    let first = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<&str> = first.lines().collect();
+    assert_eq!(rows.len(), 4, "{first}");
+    for (row, family) in rows[1..].iter().zip(["splm,", "sppm,", "bond_based,"]) {
+        assert!(
+            row.starts_with(family) && row.contains(",completed,"),
+            "{row}"
+        );
+    }
+    // a failed row is tried again, the finished ones are kept as they are
+    let failed = first.replace(
+        &rows[2].to_string(),
+        "sppm,discretisation.lattice=random,failed,,,,,,,,,,,\"stopped\"",
+    );
+    std::fs::write(&csv, failed).unwrap();
+    let again = common::sppm(&args);
+    assert!(again.status.success());
+    let second = std::fs::read_to_string(&csv).unwrap();
+    let mut a: Vec<&str> = first.lines().collect();
+    let mut b: Vec<&str> = second.lines().collect();
+    // the retried row's wall time may differ: compare all but the last two columns
+    let trim = |l: &str| l.rsplitn(3, ',').nth(2).unwrap_or(l).to_string();
+    a.sort();
+    b.sort();
+    assert_eq!(
+        a.iter().map(|l| trim(l)).collect::<Vec<_>>(),
+        b.iter().map(|l| trim(l)).collect::<Vec<_>>()
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -10,7 +10,7 @@ use super::softening::Softening;
 use nalgebra::SVector;
 use rayon::prelude::*;
 
-/// The short-range repulsion of Foster et al. and of the extended model of concrete: points
+/// The short-range repulsion of LAMMPS's peri styles and of the extended model of concrete: points
 /// pressed closer than d_ij = min(0.9·ξ, 1.35·(r_i + r_j)) push apart with a stiffness 15·c
 /// (docs/bond_based.md, "Contact").
 #[derive(Clone, Copy, Debug)]

@@ -145,14 +145,19 @@ impl<const D: usize> BondBody<D> {
             // k·s/|y| = k·(1/ξ − 1/|y|): one division
             coef[t] = k[t] as f64 * (inv_xi[t] - 1.0 / len[t]);
         }
-        // the common case: elastic and whole, a new largest stretch kept
+        // the common case: elastic and whole, a new largest stretch kept, not touching (the
+        // contact distance min(reach, 0.9·ξ) is a stretch of at most −0.1)
         let limit = self.elastic_limit as f32;
         let crush = -self.settings.compressive.unwrap_or(f64::INFINITY);
-        let touch = self.contact.is_some();
+        let touch = match &self.contact {
+            Some(_) => -0.1,
+            None => f64::NEG_INFINITY,
+        };
+        let crush = crush.max(touch);
         let mut rare = 0u32;
         for t in 0..m {
             let st = s[t] as f32;
-            let common = sm[t] < limit && st < limit && s[t] > crush && !touch;
+            let common = sm[t] < limit && st < limit && s[t] > crush;
             sm[t] = if common { sm[t].max(st) } else { sm[t] };
             coef[t] = if common { coef[t] } else { 0.0 };
             rare += u32::from(!common);
@@ -171,7 +176,7 @@ impl<const D: usize> BondBody<D> {
         if rare > 0 {
             for t in 0..m {
                 let st = s[t] as f32;
-                let common = sm[t] < limit && st < limit && s[t] > crush && !touch;
+                let common = sm[t] < limit && st < limit && s[t] > crush;
                 if !common {
                     let yt = SVector::<f64, D>::from_fn(|c, _| y[c][t]);
                     sum += self.bond_beyond_elastic(lo + t, yt, len[t], s[t], k[t], &mut sm[t]);

@@ -1,0 +1,204 @@
+//! `sppm study families`: one specimen under each model family, side by side (docs/bond_based.md,
+//! "Side by side"): the scene as written (the state-based lattice SPLM), its body in random
+//! particles (SPPM) and the bond-based model on the scene's own particles, each row with its
+//! peak force, dissipated energy, crack and wall time. Each finished row is written to
+//! families.csv at once; the same command resumes an interrupted study.
+
+use super::crack_path::{principal_line, CRACK_PATH_DAMAGE};
+use crate::run::{run, Outcome, RunOptions};
+use crate::scene::Scene;
+use nalgebra::Vector2;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The point damage φ (the share of a point's bond stiffness lost) at and above which a
+/// bond-based point belongs to the crack: a point beside a straight crack through a whole
+/// family loses about half of it; 0.35 keeps the row of points on either side of the crack
+/// and not the points a spacing further, which lose a fifth or less.
+pub const BOND_CRACK_DAMAGE: f64 = 0.35;
+
+/// One row of the study: a family and the scene overrides that select it.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    pub label: &'static str,
+    pub overrides: Vec<String>,
+}
+
+/// The variants of a scene: as written; random particles (lattice scenes only); bond-based
+/// on the scene's particles (bond dampers off: the bond-based body has none).
+pub fn variants(scene: &Scene) -> Vec<Variant> {
+    let mut out = vec![Variant {
+        label: if scene.discretisation.is_random() {
+            "sppm"
+        } else {
+            "splm"
+        },
+        overrides: vec![],
+    }];
+    if !scene.discretisation.is_random() && !scene.model.is_bond_based() {
+        out.push(Variant {
+            label: "sppm",
+            // a random particle set has no origin: the lattice's offset goes
+            overrides: vec![
+                "discretisation.lattice=random".into(),
+                "discretisation.offset=[0.0, 0.0]".into(),
+            ],
+        });
+    }
+    let mut bond = vec!["model.family=bond_based".to_string()];
+    if scene.damping.internal != 0.0 {
+        bond.push("damping.internal=0".into());
+    }
+    out.push(Variant {
+        label: "bond_based",
+        overrides: bond,
+    });
+    out
+}
+
+/// The columns of families.csv.
+pub const COLUMNS: &[&str] = &[
+    "family",
+    "overrides",
+    "status",
+    "particles",
+    "bonds",
+    "peak_force_N",
+    "displacement_at_peak_m",
+    "dissipated_energy_J",
+    "crack_points",
+    "crack_centroid_x_m",
+    "crack_centroid_y_m",
+    "crack_axis_deg",
+    "wall_time_s",
+    "message",
+];
+
+/// The crack of a run: its points (w_t ≥ [`CRACK_PATH_DAMAGE`] for the lattice and random
+/// particles, φ ≥ [`BOND_CRACK_DAMAGE`] for the bond-based model), their centroid and, in 2D,
+/// their principal axis (°, NaN in 3D).
+pub fn crack_of(o: &Outcome) -> (usize, [f64; 2], f64) {
+    let Some(d) = &o.damage else {
+        return (0, [f64::NAN; 2], f64::NAN);
+    };
+    let threshold = if o.scene.model.is_bond_based() {
+        BOND_CRACK_DAMAGE
+    } else {
+        CRACK_PATH_DAMAGE
+    };
+    let pts: Vec<Vector2<f64>> = (0..o.x0.len())
+        .filter(|&i| d[i].wt >= threshold)
+        .map(|i| o.point2(i))
+        .collect();
+    if pts.is_empty() {
+        return (0, [f64::NAN; 2], f64::NAN);
+    }
+    let c = pts.iter().sum::<Vector2<f64>>() / pts.len() as f64;
+    let axis = match (o.dim, principal_line(&pts)) {
+        (2, Some(line)) => line.axis_deg,
+        _ => f64::NAN,
+    };
+    (pts.len(), [c.x, c.y], axis)
+}
+
+/// The families an unfinished study in `csv` has finished; a row that failed is dropped
+/// from the file, so that the same command tries it again.
+fn finished(csv: &Path) -> std::io::Result<Vec<String>> {
+    let Ok(text) = std::fs::read_to_string(csv) else {
+        return Ok(Vec::new());
+    };
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or_default();
+    let kept: Vec<&str> = lines
+        .filter(|l| l.split(',').nth(2) != Some("failed"))
+        .collect();
+    let mut body = format!("{header}\n");
+    for l in &kept {
+        body.push_str(l);
+        body.push('\n');
+    }
+    std::fs::write(csv, body)?;
+    Ok(kept
+        .iter()
+        .filter_map(|l| l.split(',').next().map(String::from))
+        .collect())
+}
+
+/// Run every variant of the scene not yet in `<out>/families.csv` (with the `overrides` of
+/// every run), appending each row as it finishes; the table's rows.
+pub fn families(scene: &Path, overrides: &[String], out: &Path) -> anyhow::Result<Vec<String>> {
+    let base = Scene::from_file(scene, overrides)?;
+    std::fs::create_dir_all(out)?;
+    let csv = out.join("families.csv");
+    if !csv.exists() {
+        std::fs::write(&csv, format!("{}\n", COLUMNS.join(",")))?;
+    }
+    let done = finished(&csv)?;
+    for v in variants(&base) {
+        if done.iter().any(|f| f == v.label) {
+            continue;
+        }
+        let mut o = overrides.to_vec();
+        o.extend(v.overrides.iter().cloned());
+        let row = match Scene::from_file(scene, &o)
+            .map_err(anyhow::Error::from)
+            .and_then(|s| Ok(run(&s, &RunOptions::default())?))
+        {
+            Ok(outcome) => {
+                let dir = out.join(v.label);
+                crate::output::write_all(&outcome, &dir)?;
+                row_of(v.label, &v.overrides, &outcome)
+            }
+            Err(e) => failed_row(v.label, &v.overrides, &e.to_string()),
+        };
+        let mut f = std::fs::OpenOptions::new().append(true).open(&csv)?;
+        writeln!(f, "{row}")?;
+    }
+    Ok(std::fs::read_to_string(&csv)?
+        .lines()
+        .map(String::from)
+        .collect())
+}
+
+fn row_of(label: &str, overrides: &[String], o: &Outcome) -> String {
+    let s = &o.summary;
+    let (n, c, axis) = crack_of(o);
+    let fields = [
+        label.to_string(),
+        overrides.join(" "),
+        s.status.clone(),
+        s.particles.to_string(),
+        s.bonds.to_string(),
+        format!("{:.6e}", s.peak_force_n),
+        format!("{:.6e}", s.displacement_at_peak_m),
+        format!("{:.6e}", s.dissipated_energy_j),
+        n.to_string(),
+        format!("{:.6e}", c[0]),
+        format!("{:.6e}", c[1]),
+        format!("{axis:.3}"),
+        format!("{:.2}", s.wall_time_s),
+        quote(s.message.as_deref().unwrap_or("")),
+    ];
+    fields.join(",")
+}
+
+fn failed_row(label: &str, overrides: &[String], message: &str) -> String {
+    let mut fields = vec![label.to_string(), overrides.join(" "), "failed".into()];
+    fields.extend(std::iter::repeat_n(String::new(), COLUMNS.len() - 4));
+    fields.push(quote(message));
+    fields.join(",")
+}
+
+/// A CSV field with its commas and quotes escaped.
+fn quote(text: &str) -> String {
+    format!("\"{}\"", text.replace('"', "\"\""))
+}
+
+/// The default folder of the study of a scene.
+pub fn default_out(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    PathBuf::from("output").join(format!("{stem}-families"))
+}
