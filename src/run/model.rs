@@ -136,6 +136,19 @@ pub fn memory_in_slots(scene: &Scene, slots: usize) -> f64 {
 /// kernel's too).
 fn model_memory(scene: &Scene, slots: usize) -> f64 {
     let dim = scene.dim();
+    if scene.model.is_bond_based() {
+        // the families' candidates and arrays while the body is built (the peak: 53 bytes a
+        // bond at 10^6 points, benchmarks/RESULTS.md "Bond-based kernel against LAMMPS"),
+        // with the bonds of a whole family: the ball of radius m cells
+        let m = scene.model.horizon();
+        let bonds = if dim == 3 {
+            4.0 / 3.0 * std::f64::consts::PI * m.powi(3)
+        } else {
+            std::f64::consts::PI * m * m
+        };
+        let point = bytes_per_particle(dim, slots) as f64 + 12.0 * 8.0 * dim as f64;
+        return estimated_particles(scene) * (bonds * BOND_BUILD_BYTES + point);
+    }
     let damage = if scene.concrete.is_some() {
         crate::solver::inelastic::bytes_per_particle(dim, slots)
     } else {
@@ -143,6 +156,9 @@ fn model_memory(scene: &Scene, slots: usize) -> f64 {
     };
     estimated_particles(scene) * (bytes_per_particle(dim, slots) + damage) as f64
 }
+
+/// Bytes a bond-based body takes per bond (each held by both its points) while it is built.
+pub const BOND_BUILD_BYTES: f64 = 56.0;
 
 /// Estimated bytes of the frames of `output.snapshots` (0 without).
 pub fn frames_memory(scene: &Scene) -> f64 {

@@ -103,24 +103,26 @@ pub fn crack_of(o: &Outcome) -> (usize, [f64; 2], f64) {
 
 /// The families an unfinished study in `csv` has finished; a row that failed is dropped
 /// from the file, so that the same command tries it again.
-fn finished(csv: &Path) -> std::io::Result<Vec<String>> {
-    let Ok(text) = std::fs::read_to_string(csv) else {
+fn finished(csv: &Path) -> anyhow::Result<Vec<String>> {
+    if !csv.exists() {
         return Ok(Vec::new());
-    };
-    let mut lines = text.lines();
-    let header = lines.next().unwrap_or_default();
-    let kept: Vec<&str> = lines
-        .filter(|l| l.split(',').nth(2) != Some("failed"))
-        .collect();
-    let mut body = format!("{header}\n");
-    for l in &kept {
-        body.push_str(l);
-        body.push('\n');
     }
-    std::fs::write(csv, body)?;
+    let mut reader = ::csv::Reader::from_path(csv)?;
+    let header = reader.headers()?.clone();
+    let kept: Vec<::csv::StringRecord> = reader
+        .records()
+        .filter_map(Result::ok)
+        .filter(|r| r.get(2) != Some("failed"))
+        .collect();
+    let mut writer = ::csv::Writer::from_path(csv)?;
+    writer.write_record(&header)?;
+    for r in &kept {
+        writer.write_record(r)?;
+    }
+    writer.flush()?;
     Ok(kept
         .iter()
-        .filter_map(|l| l.split(',').next().map(String::from))
+        .filter_map(|r| r.get(0).map(String::from))
         .collect())
 }
 
@@ -165,7 +167,7 @@ fn row_of(label: &str, overrides: &[String], o: &Outcome) -> String {
     let (n, c, axis) = crack_of(o);
     let fields = [
         label.to_string(),
-        overrides.join(" "),
+        quote(&overrides.join(" ")),
         s.status.clone(),
         s.particles.to_string(),
         s.bonds.to_string(),
@@ -183,15 +185,23 @@ fn row_of(label: &str, overrides: &[String], o: &Outcome) -> String {
 }
 
 fn failed_row(label: &str, overrides: &[String], message: &str) -> String {
-    let mut fields = vec![label.to_string(), overrides.join(" "), "failed".into()];
+    let mut fields = vec![
+        label.to_string(),
+        quote(&overrides.join(" ")),
+        "failed".into(),
+    ];
     fields.extend(std::iter::repeat_n(String::new(), COLUMNS.len() - 4));
     fields.push(quote(message));
     fields.join(",")
 }
 
-/// A CSV field with its commas and quotes escaped.
+/// A CSV field, quoted when it holds a comma or a quote.
 fn quote(text: &str) -> String {
-    format!("\"{}\"", text.replace('"', "\"\""))
+    if text.contains([',', '"']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
 }
 
 /// The default folder of the study of a scene.
