@@ -241,19 +241,25 @@ fn dynamics<const D: usize>(
     Ok((fundamental, stable))
 }
 
-/// Run a scene of the bond-based family with its generator's points.
-pub fn run_bond_based<G, const D: usize, const K: usize>(
+/// A bond-based scene ready to run: its model (points, groups, supports) with T1, the time
+/// step and the probe; the body; its report; the points' masses.
+pub struct BondPrepared<const K: usize, const D: usize> {
+    pub p: Prepared<K, D>,
+    pub body: BondBody<D>,
+    pub report: BondReport,
+    pub mass: Vec<f64>,
+}
+
+/// Fill the scene's body with its generator's points, bond them and find T1 and the step.
+pub fn prepare_bond_based<G, const D: usize, const K: usize>(
     scene: &Scene,
     generator: G,
-    opts: &RunOptions,
-    threads: usize,
-) -> Result<Outcome, RunError>
+) -> Result<BondPrepared<K, D>, RunError>
 where
     G: Generator<D, K>,
 {
-    let start = Instant::now();
     let model = prepare_model(scene, generator)?;
-    let (body, mut report) = bond_body(&model)?;
+    let (body, report) = bond_body(&model)?;
     let mass: Vec<f64> = body.volume.iter().map(|v| scene.material.rho * v).collect();
     let (fundamental, stable) = dynamics(&body, &mass, &model.constrained)?;
     let dt = time_step(scene, stable.dt_stable)?;
@@ -270,6 +276,31 @@ where
         steps,
         probe,
     };
+    Ok(BondPrepared {
+        p,
+        body,
+        report,
+        mass,
+    })
+}
+
+/// Run a scene of the bond-based family with its generator's points.
+pub fn run_bond_based<G, const D: usize, const K: usize>(
+    scene: &Scene,
+    generator: G,
+    opts: &RunOptions,
+    threads: usize,
+) -> Result<Outcome, RunError>
+where
+    G: Generator<D, K>,
+{
+    let start = Instant::now();
+    let BondPrepared {
+        p,
+        body,
+        mut report,
+        mass,
+    } = prepare_bond_based(scene, generator)?;
     let mut stepper = Stepper::new(&p, body, mass);
     let finished = stepper.run(&p, opts, start);
     let body = &stepper.body;

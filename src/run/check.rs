@@ -38,6 +38,9 @@ impl TypedRun for Check<'_> {
         G: Generator<D, K>,
         Dim<D>: Dimension<D> + Recover<D>,
     {
+        if sc.model.is_bond_based() {
+            return bond_report(sc, self.mem, self.stage, generator);
+        }
         let p = prepare_with(sc, generator, self.stage)?;
         report(sc, self.mem, self.stage, p)
     }
@@ -185,6 +188,84 @@ where
             m.unfitted
         );
     }
+    Ok(())
+}
+
+/// `sppm check` of a bond-based scene: the points, the bonds and the law, T1, the time step,
+/// memory and the run time from a few timed steps.
+fn bond_report<G, const D: usize, const K: usize>(
+    sc: &Scene,
+    mem: f64,
+    stage: &dyn Fn(&str),
+    generator: G,
+) -> Result<(), RunError>
+where
+    G: Generator<D, K>,
+{
+    stage("bonding the points and finding T1");
+    let b = super::bond_based::prepare_bond_based(sc, generator)?;
+    let (p, r) = (&b.p, &b.report);
+    stage("timing a few steps of the kernel");
+    let calib = 20.min(p.steps.max(1));
+    let mut stepper = super::bond_based::Stepper::new(p, b.body.clone(), b.mass.clone());
+    let t = std::time::Instant::now();
+    stepper.steps(p, calib);
+    let per_step = t.elapsed().as_secs_f64() / calib as f64;
+    say!("scene            {}", sc.name());
+    for w in &sc.warnings {
+        eprintln!("warning: {w}");
+    }
+    say!(
+        "model            bond_based ({D}D), on {} points",
+        sc.discretisation.lattice.name()
+    );
+    say!("points           {}", p.model.particles.len());
+    say!(
+        "bonds            {} ({:.1} a point)",
+        r.bonds,
+        r.bonds_per_point
+    );
+    say!(
+        "horizon          {:.6e} m = {} × Δx ({:.6e} m)",
+        r.horizon_m,
+        r.horizon_ratio,
+        r.cell_size_m
+    );
+    say!(
+        "micromodulus     {:.6e} ({:?} influence)",
+        r.micromodulus,
+        r.influence
+    );
+    if let (Some(law), Some(s0), Some(sc_)) = (r.softening, r.s0, r.critical_stretch) {
+        say!(
+            "softening        {}: s0 = {s0:.4e}, s_c = {sc_:.4e}",
+            law.name()
+        );
+    }
+    say!(
+        "groups           {}",
+        p.model
+            .groups
+            .iter()
+            .map(|g| format!("{} ({})", g.name, g.members.len()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    say!("fundamental T1   {:.6e} s", p.fundamental.period);
+    say!("stable dt        {:.6e} s", p.stable.dt_stable);
+    say!("time step dt     {:.6e} s", p.dt);
+    say!(
+        "t_end            {:.6e} s = {:.1} T1",
+        p.t_end,
+        p.t_end / p.fundamental.period
+    );
+    say!("steps            {}", p.steps);
+    say!("memory (est.)    {:.1} MiB", mem / 2f64.powi(20));
+    say!(
+        "run time (est.)  {:.1} s on {} threads",
+        per_step * p.steps as f64,
+        rayon::current_num_threads()
+    );
     Ok(())
 }
 

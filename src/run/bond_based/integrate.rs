@@ -110,6 +110,13 @@ impl<const D: usize> Stepper<D> {
         }
     }
 
+    /// `n` steps from rest (for timing), without records.
+    pub fn steps<const K: usize>(&mut self, p: &Prepared<K, D>, n: usize) {
+        for k in 0..n {
+            self.step(k as f64 * p.dt, p.dt, &p.model.scene, p.t_end);
+        }
+    }
+
     /// The record at step n (time t), the forces `f` at the current positions.
     fn record(&self, n: usize, t: f64, probe: &Probe, load: f64) -> Record {
         let kinetic: f64 = self
