@@ -7,6 +7,7 @@
 use super::generate::Generator;
 use super::model::Model;
 use super::prepare::{checked_steps, loading_time, prepare_model, probe_of, time_step, Prepared};
+pub use super::summary::BondReport;
 use super::summary::{point3, summarise, Finished, Outcome, SolverReport};
 use super::{RunError, RunOptions};
 use crate::model::bond_based::body::{BodySettings, BondBody};
@@ -21,43 +22,10 @@ use crate::solver::modal::{self, Fundamental, EIGEN_TOLERANCE};
 use crate::solver::time_step::StableStep;
 use crate::solver::{Location, Probe, Record, Unstable};
 use nalgebra::SVector;
-use serde::Serialize;
 use std::time::Instant;
 
 mod integrate;
 pub use integrate::Stepper;
-
-/// What summary.json reports of a bond-based run (`bond_based`).
-#[derive(Clone, Debug, Serialize)]
-pub struct BondReport {
-    /// Horizon δ (m) and its ratio m = δ/Δx.
-    pub horizon_m: f64,
-    pub horizon_ratio: f64,
-    /// Δx of the partial volumes (m): the grid spacing, or the mean cell's edge.
-    pub cell_size_m: f64,
-    /// Micromodulus c (constant influence) or c0 (conical), N/m⁶ (N/m⁵ in a plate).
-    pub micromodulus: f64,
-    pub influence: InfluenceKind,
-    pub poisson_ratio_of_the_model: f64,
-    pub softening: Option<SofteningKind>,
-    /// The bulk law's stretches: where softening starts and where the bond breaks.
-    pub s0: Option<f64>,
-    pub critical_stretch: Option<f64>,
-    pub compressive_stretch: Option<f64>,
-    pub surface_correction: bool,
-    pub critical_stretch_correction: bool,
-    pub contact: bool,
-    /// Bonds (each counted once), their mean per point, and how many broke.
-    pub bonds: usize,
-    pub bonds_per_point: f64,
-    pub broken_bonds: usize,
-    /// The largest point damage φ (the share of a point's bond stiffness lost) and the
-    /// points with φ ≥ 0.5.
-    pub max_point_damage: f64,
-    pub points_half_damaged: usize,
-    /// The rule that ended the run early (`loading.stop_rule`), if one did.
-    pub stopped_by: Option<String>,
-}
 
 /// The bond-based body of a model's points, with the scene's `[model]` choices and, with
 /// `[concrete]`, its softening law; and the run's report of it.

@@ -108,7 +108,7 @@ pub struct Summary {
     /// The bond-based family (`model.family = "bond_based"`): its horizon, micromodulus,
     /// law and bonds; absent for the state-based lattice.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub bond_based: Option<super::bond_based::BondReport>,
+    pub bond_based: Option<BondReport>,
     /// Random particles (SPPM): generation (count, distances, bond histogram, times), the
     /// minimum distance, and the micro-moduli residual statistics; absent for lattices.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -140,6 +140,38 @@ pub struct Summary {
     /// Each random field: its parameters, seed and the statistics of the particles' values.
     pub random_fields: Vec<FieldReport>,
     pub sppm_version: String,
+}
+
+/// What summary.json reports of a bond-based run (`bond_based`).
+#[derive(Clone, Debug, Serialize)]
+pub struct BondReport {
+    /// Horizon δ (m) and its ratio m = δ/Δx.
+    pub horizon_m: f64,
+    pub horizon_ratio: f64,
+    /// Δx of the partial volumes (m): the grid spacing, or the mean cell's edge.
+    pub cell_size_m: f64,
+    /// Micromodulus c (constant influence) or c0 (conical), N/m⁶ (N/m⁵ in a plate).
+    pub micromodulus: f64,
+    pub influence: crate::scene::model_family::InfluenceKind,
+    pub poisson_ratio_of_the_model: f64,
+    pub softening: Option<crate::scene::model_family::SofteningKind>,
+    /// The bulk law's stretches: where softening starts and where the bond breaks.
+    pub s0: Option<f64>,
+    pub critical_stretch: Option<f64>,
+    pub compressive_stretch: Option<f64>,
+    pub surface_correction: bool,
+    pub critical_stretch_correction: bool,
+    pub contact: bool,
+    /// Bonds (each counted once), their mean per point, and how many broke.
+    pub bonds: usize,
+    pub bonds_per_point: f64,
+    pub broken_bonds: usize,
+    /// The largest point damage φ (the share of a point's bond stiffness lost) and the
+    /// points with φ ≥ 0.5.
+    pub max_point_damage: f64,
+    pub points_half_damaged: usize,
+    /// The rule that ended the run early (`loading.stop_rule`), if one did.
+    pub stopped_by: Option<String>,
 }
 
 /// The kinetic-to-elastic energy ratio around the peak below which a run counts as

@@ -96,6 +96,9 @@ pub enum StudyCommand {
         /// Study folder (default: output/<scene file stem>-families).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// The families to run, comma-separated: splm, sppm, bond_based (default all).
+        #[arg(long, default_value = "splm,sppm,bond_based")]
+        families: String,
     },
     /// Combine the shard folders of one Monte Carlo study: realisations.csv,
     /// deterministic.csv and the size-effect report in --out.
@@ -249,9 +252,22 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
             no_data(&empty, "realisations.csv");
             Ok(status(report.completed, report.runs))
         }
-        StudyCommand::Families { scene, set, out } => {
+        StudyCommand::Families {
+            scene,
+            set,
+            out,
+            families,
+        } => {
             let out = out.unwrap_or_else(|| super::families::default_out(&scene));
-            let rows = super::families::families(&scene, &set, &out)?;
+            let wanted: Vec<&str> = families.split(',').map(str::trim).collect();
+            for w in &wanted {
+                if !["splm", "sppm", "bond_based"].contains(w) {
+                    anyhow::bail!(
+                        "--families: {w:?} is not a family; allowed: splm, sppm, bond_based"
+                    );
+                }
+            }
+            let rows = super::families::families(&scene, &set, &out, &wanted)?;
             for r in &rows {
                 crate::say!("{r}");
             }

@@ -126,9 +126,15 @@ fn finished(csv: &Path) -> anyhow::Result<Vec<String>> {
         .collect())
 }
 
-/// Run every variant of the scene not yet in `<out>/families.csv` (with the `overrides` of
-/// every run), appending each row as it finishes; the table's rows.
-pub fn families(scene: &Path, overrides: &[String], out: &Path) -> anyhow::Result<Vec<String>> {
+/// Run every variant of the scene among the `wanted` families not yet in
+/// `<out>/families.csv` (with the `overrides` of every run), appending each row as it
+/// finishes; the table's rows.
+pub fn families(
+    scene: &Path,
+    overrides: &[String],
+    out: &Path,
+    wanted: &[&str],
+) -> anyhow::Result<Vec<String>> {
     let base = Scene::from_file(scene, overrides)?;
     std::fs::create_dir_all(out)?;
     let csv = out.join("families.csv");
@@ -137,7 +143,7 @@ pub fn families(scene: &Path, overrides: &[String], out: &Path) -> anyhow::Resul
     }
     let done = finished(&csv)?;
     for v in variants(&base) {
-        if done.iter().any(|f| f == v.label) {
+        if done.iter().any(|f| f == v.label) || !wanted.contains(&v.label) {
             continue;
         }
         let mut o = overrides.to_vec();

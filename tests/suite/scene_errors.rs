@@ -515,3 +515,16 @@ fn model_family_keys() {
         &["output.snapshots = 4", "absent with model.family"],
     );
 }
+
+/// The cubic grid is aligned with the axes: a rotation of it is refused, not ignored.
+#[test]
+fn a_turned_cubic_grid_is_refused() {
+    says(
+        &error_of(&[
+            "model.family=bond_based",
+            "discretisation.lattice=cubic",
+            "discretisation.rotation_deg=15",
+        ]),
+        &["discretisation.rotation_deg = [15.0, 0.0, 0.0]", "cubic"],
+    );
+}

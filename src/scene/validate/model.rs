@@ -30,6 +30,14 @@ impl Scene {
             }
             return Ok(());
         }
+        let turn = self.discretisation.rotation_deg.angles();
+        if self.discretisation.lattice == Lattice::Cubic && turn.iter().any(|a| *a != 0.0) {
+            return Err(invalid(
+                "discretisation.rotation_deg",
+                format!("{turn:?}"),
+                "0 (or absent) for lattice = \"cubic\": the grid is aligned with the axes; turn the body or use another discretisation's points",
+            ));
+        }
         let (lo, hi) = HORIZON_RANGE;
         if let Some(h) = m.horizon {
             if !(h.is_finite() && (lo..=hi).contains(&h)) {
