@@ -4,7 +4,7 @@
 //! peak force, dissipated energy, crack and wall time. Each finished row is written to
 //! families.csv at once; the same command resumes an interrupted study.
 
-use super::crack_path::{principal_line, CRACK_PATH_DAMAGE};
+use super::crack_path::{crack_path, Clearance, CLEARANCE_SPACINGS, CRACK_PATH_DAMAGE};
 use crate::run::{run, Outcome, RunOptions};
 use crate::scene::Scene;
 use nalgebra::Vector2;
@@ -22,6 +22,28 @@ pub const BOND_CRACK_DAMAGE: f64 = 0.35;
 pub struct Variant {
     pub label: &'static str,
     pub overrides: Vec<String>,
+}
+
+/// What the bond-based row says it left out of the scene file, besides its overrides.
+const SNAPSHOTS_LEFT_OUT: &str = "(output.snapshots left out)";
+
+/// The scene of a variant: the file with the overrides; for the bond-based family without
+/// `output.snapshots` (its run records no time series; the row's overrides say so).
+fn variant_scene(path: &Path, overrides: &[String], bond_based: bool) -> anyhow::Result<Scene> {
+    if !bond_based {
+        return Ok(Scene::from_file(path, overrides)?);
+    }
+    let text = crate::scene::read_scene_text(path)?;
+    let mut table: toml::Table = text.parse()?;
+    if let Some(toml::Value::Table(out)) = table.get_mut("output") {
+        out.remove("snapshots");
+    }
+    let mut scene =
+        Scene::from_toml_str(&table.to_string(), overrides).map_err(|e| e.in_file(path))?;
+    if scene.name.is_none() {
+        scene.name = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+    }
+    Ok(scene)
 }
 
 /// The variants of a scene: as written; random particles (lattice scenes only); bond-based
@@ -46,6 +68,7 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
         });
     }
     let mut bond = vec!["model.family=bond_based".to_string()];
+
     if scene.damping.internal != 0.0 {
         bond.push("damping.internal=0".into());
     }
@@ -75,8 +98,10 @@ pub const COLUMNS: &[&str] = &[
 ];
 
 /// The crack of a run: its points (w_t ≥ [`CRACK_PATH_DAMAGE`] for the lattice and random
-/// particles, φ ≥ [`BOND_CRACK_DAMAGE`] for the bond-based model), their centroid and, in 2D,
-/// their principal axis (°, NaN in 3D).
+/// particles, φ ≥ [`BOND_CRACK_DAMAGE`] for the bond-based model) beyond
+/// [`CLEARANCE_SPACINGS`] spacings of a support or a loaded group (as the objectivity study
+/// counts them), their centroid in the x–y plane and, in 2D, their principal axis (°; NaN in
+/// 3D).
 pub fn crack_of(o: &Outcome) -> (usize, [f64; 2], f64) {
     let Some(d) = &o.damage else {
         return (0, [f64::NAN; 2], f64::NAN);
@@ -86,19 +111,21 @@ pub fn crack_of(o: &Outcome) -> (usize, [f64; 2], f64) {
     } else {
         CRACK_PATH_DAMAGE
     };
-    let pts: Vec<Vector2<f64>> = (0..o.x0.len())
-        .filter(|&i| d[i].wt >= threshold)
-        .map(|i| o.point2(i))
-        .collect();
-    if pts.is_empty() {
-        return (0, [f64::NAN; 2], f64::NAN);
-    }
-    let c = pts.iter().sum::<Vector2<f64>>() / pts.len() as f64;
-    let axis = match (o.dim, principal_line(&pts)) {
-        (2, Some(line)) => line.axis_deg,
-        _ => f64::NAN,
+    let x0: Vec<Vector2<f64>> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
+    let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    let held = super::objectivity::held_points(o);
+    let clear = Clearance {
+        held: &held,
+        distance: CLEARANCE_SPACINGS * o.scene.discretisation.spacing,
     };
-    (pts.len(), [c.x, c.y], axis)
+    match crack_path(&x0, &wt, threshold, &clear) {
+        Ok(p) => (
+            p.particles,
+            p.centroid_m,
+            if o.dim == 2 { p.axis_deg } else { f64::NAN },
+        ),
+        Err(_) => (0, [f64::NAN; 2], f64::NAN),
+    }
 }
 
 /// The families an unfinished study in `csv` has finished; a row that failed is dropped
@@ -148,16 +175,15 @@ pub fn families(
         }
         let mut o = overrides.to_vec();
         o.extend(v.overrides.iter().cloned());
-        let row = match Scene::from_file(scene, &o)
-            .map_err(anyhow::Error::from)
+        let row = match variant_scene(scene, &o, v.label == "bond_based")
             .and_then(|s| Ok(run(&s, &RunOptions::default())?))
         {
             Ok(outcome) => {
                 let dir = out.join(v.label);
                 crate::output::write_all(&outcome, &dir)?;
-                row_of(v.label, &v.overrides, &outcome)
+                row_of(v.label, &said(&v, &base), &outcome)
             }
-            Err(e) => failed_row(v.label, &v.overrides, &e.to_string()),
+            Err(e) => failed_row(v.label, &said(&v, &base), &e.to_string()),
         };
         let mut f = std::fs::OpenOptions::new().append(true).open(&csv)?;
         writeln!(f, "{row}")?;
@@ -166,6 +192,15 @@ pub fn families(
         .lines()
         .map(String::from)
         .collect())
+}
+
+/// The overrides of a variant as its row says them, with what it left out of the file.
+fn said(v: &Variant, base: &Scene) -> Vec<String> {
+    let mut o = v.overrides.clone();
+    if v.label == "bond_based" && base.output.snapshots.is_some() {
+        o.push(SNAPSHOTS_LEFT_OUT.into());
+    }
+    o
 }
 
 fn row_of(label: &str, overrides: &[String], o: &Outcome) -> String {

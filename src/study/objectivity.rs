@@ -113,7 +113,7 @@ pub const CRACK_COLUMNS: [&str; 10] = [
 
 /// The in-plane reference positions of the particles of the groups with prescribed
 /// displacements: the supports (fixed components) and the loaded groups.
-fn held_points(o: &Outcome) -> Vec<Vector2<f64>> {
+pub(crate) fn held_points(o: &Outcome) -> Vec<Vector2<f64>> {
     let held: Vec<&str> = o
         .scene
         .groups
