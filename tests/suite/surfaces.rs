@@ -25,7 +25,7 @@ fn placement(rotation_deg: f64, offset: [f64; 2], surface: &'static str) -> Plac
 const OFFSETS: [[f64; 2]; 3] = [[0.0, 0.0], [0.37, 0.61], [0.83, 0.12]];
 
 /// Every shipped lattice body carries ρ·V of the real body at rotations 0/15/30/45° and three
-/// offsets. Issue acceptance: 0.5%; the clipped cells are exact, so the test holds them to
+/// offsets. Asked: 0.5%; the clipped cells are exact, so the test holds them to
 /// round-off (1e-9).
 #[test]
 fn every_shipped_body_carries_its_mass_at_any_rotation_and_offset() {
