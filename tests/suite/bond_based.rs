@@ -46,6 +46,7 @@ fn an_elastic_bond_based_run_conserves_energy() {
         &[
             "discretisation.lattice=cubic",
             "discretisation.spacing=0.005",
+            "discretisation.rotation_deg=[0.0, 0.0, 0.0]",
         ][..],
         &["discretisation.spacing=0.00625"][..],
     ] {
