@@ -9,6 +9,7 @@
 
 use nalgebra::Vector3;
 use sppm::model::bond_based::body::{BodySettings, BondBody};
+use sppm::model::bond_based::family::CubicGrid;
 use sppm::model::bond_based::micromodulus::{micromodulus, Body, Influence};
 use std::time::Instant;
 
@@ -22,12 +23,7 @@ fn main() {
         .expect("thread pool");
     let (dx, e, rho) = (0.005, 37e9, 2346.0);
     let delta = std::f64::consts::PI * dx;
-    let x0: Vec<Vector3<f64>> = (0..n * n * n)
-        .map(|p| {
-            let (i, j, k) = (p % n, (p / n) % n, p / (n * n));
-            Vector3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * dx
-        })
-        .collect();
+    let x0 = CubicGrid { n: [n, n, n], dx }.points();
     let settings = BodySettings {
         delta,
         dx,

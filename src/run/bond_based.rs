@@ -9,18 +9,17 @@ use super::model::Model;
 use super::prepare::{checked_steps, loading_time, prepare_model, probe_of, time_step, Prepared};
 pub use super::summary::BondReport;
 use super::summary::{point3, summarise, Finished, Outcome, SolverReport};
-use super::{RunError, RunOptions};
+use super::RunError;
 use crate::model::bond_based::body::{BodySettings, BondBody};
 use crate::model::bond_based::micromodulus::{micromodulus, Body, Influence};
 use crate::model::bond_based::softening::{Fit, Softening};
 use crate::model::damage_law::ParticleDamage;
 use crate::scene::model_family::{InfluenceKind, SofteningKind};
 use crate::scene::{Plane, Scene};
-use crate::solver::lanczos::{Extreme, Lanczos};
 use crate::solver::loading::ramp_fraction;
-use crate::solver::modal::{self, Fundamental, EIGEN_TOLERANCE};
+use crate::solver::modal::{self, Fundamental};
 use crate::solver::time_step::StableStep;
-use crate::solver::{Location, Probe, Record, Unstable};
+use crate::solver::{Location, Record, Unstable};
 use nalgebra::SVector;
 use std::time::Instant;
 
@@ -164,34 +163,15 @@ fn dynamics<const D: usize>(
     mass: &[f64],
     constrained: &[[bool; D]],
 ) -> Result<(Fundamental, StableStep), RunError> {
-    let modes = modal::mechanisms(&body.x0, mass, constrained);
-    if constrained.iter().all(|c| c.iter().all(|&b| b)) {
-        return Err(RunError::Setup("every point is constrained: groups fix or load every component of every point, so nothing is left to move; free some components (groups.*.fix, groups.*.load)".into()));
-    }
-    let est = Lanczos {
-        mass,
-        constrained: Some(constrained),
-        deflate: &modes,
-        which: Extreme::Smallest,
-        tolerance: EIGEN_TOLERANCE,
-        max_steps: 20_000,
-    }
-    .run(|u, out| {
-        body.linear_forces(u, out);
-        out.iter_mut().for_each(|v| *v = -*v);
-    });
-    if !est.converged || est.eigenvalue.is_nan() || est.eigenvalue <= 0.0 {
-        return Err(RunError::Setup(format!(
-            "the fundamental period of the bond-based body could not be computed (Lanczos: {} steps, ω1² = {:e}); the supports (groups.*.fix, groups.*.load) may leave a mechanism",
-            est.steps, est.eigenvalue
-        )));
-    }
-    let fundamental = Fundamental {
-        eigenvalue: est.eigenvalue,
-        period: 2.0 * std::f64::consts::PI / est.eigenvalue.sqrt(),
-        iterations: est.steps,
-        mechanisms: modes.len(),
-    };
+    let fundamental =
+        modal::lowest_mode(&body.x0, mass, constrained, LANCZOS_STEPS, |u, out| {
+            body.linear_forces(u, out)
+        })
+        .map_err(|e| {
+            RunError::Setup(format!(
+                "{e}: T1 of the bond-based body is the lowest mode held by its supports (groups.*.fix, groups.*.load); they may leave a mechanism"
+            ))
+        })?;
     let dt_stable = body
         .stiffness_sums()
         .iter()
@@ -252,11 +232,13 @@ where
     })
 }
 
+/// Lanczos steps allowed for the bond-based body's T1.
+const LANCZOS_STEPS: usize = 20_000;
+
 /// Run a scene of the bond-based family with its generator's points.
 pub fn run_bond_based<G, const D: usize, const K: usize>(
     scene: &Scene,
     generator: G,
-    opts: &RunOptions,
     threads: usize,
 ) -> Result<Outcome, RunError>
 where
@@ -270,7 +252,7 @@ where
         mass,
     } = prepare_bond_based(scene, generator)?;
     let mut stepper = Stepper::new(&p, body, mass);
-    let finished = stepper.run(&p, opts, start);
+    let finished = stepper.run(&p, start);
     let body = &stepper.body;
     let phi = body.damage();
     report.broken_bonds = body.broken_bonds();
@@ -373,11 +355,6 @@ fn unstable_at<const D: usize>(
         },
         what: "the position is not a finite number".into(),
     })
-}
-
-/// The reaction of the probe, −Σ of the internal forces on its members along its component.
-fn reaction<const D: usize>(probe: &Probe, f: &[SVector<f64, D>]) -> f64 {
-    probe.reaction(f)
 }
 
 /// The fraction of Δmax the ramp applies at time t.

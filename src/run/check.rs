@@ -83,18 +83,7 @@ where
     }
     say!("particles        {}", p.model.particles.len());
     say!("bonds            {}", p.model.particles.bonds());
-    say!(
-        "groups           {}",
-        p.model
-            .groups
-            .iter()
-            .map(|g| format!("{} ({})", g.name, g.members.len()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    say!("fundamental T1   {:.6e} s", p.fundamental.period);
-    say!("stable dt        {:.6e} s", p.stable.dt_stable);
-    say!("time step dt     {:.6e} s", p.dt);
+    say_groups_and_step(&p);
     say_fast_options(sc, &p);
     let threads = rayon::current_num_threads();
     let solver = &sc.solver;
@@ -242,18 +231,7 @@ where
             law.name()
         );
     }
-    say!(
-        "groups           {}",
-        p.model
-            .groups
-            .iter()
-            .map(|g| format!("{} ({})", g.name, g.members.len()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    say!("fundamental T1   {:.6e} s", p.fundamental.period);
-    say!("stable dt        {:.6e} s", p.stable.dt_stable);
-    say!("time step dt     {:.6e} s", p.dt);
+    say_groups_and_step(p);
     say!(
         "t_end            {:.6e} s = {:.1} T1",
         p.t_end,
@@ -267,6 +245,22 @@ where
         rayon::current_num_threads()
     );
     Ok(())
+}
+
+/// The groups with their sizes, T1, the stable step and the step of a prepared scene.
+fn say_groups_and_step<const K: usize, const D: usize>(p: &Prepared<K, D>) {
+    say!(
+        "groups           {}",
+        p.model
+            .groups
+            .iter()
+            .map(|g| format!("{} ({})", g.name, g.members.len()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    say!("fundamental T1   {:.6e} s", p.fundamental.period);
+    say!("stable dt        {:.6e} s", p.stable.dt_stable);
+    say!("time step dt     {:.6e} s", p.dt);
 }
 
 /// What `sppm check` says of the fast options a scene turned on: the semi-implicit bond

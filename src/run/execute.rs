@@ -89,7 +89,7 @@ impl TypedRun for Execute<'_> {
         Dim<D>: Dimension<D> + Recover<D>,
     {
         if scene.model.is_bond_based() {
-            return super::bond_based::run_bond_based(scene, generator, self.opts, self.threads);
+            return super::bond_based::run_bond_based(scene, generator, self.threads);
         }
         let p = prepare(scene, generator)?;
         run_prepared(

@@ -185,15 +185,29 @@ pub fn fundamental<const D: usize, const K: usize>(
     x0: &[SVector<f64, D>],
     constrained: &[[bool; D]],
 ) -> Result<Fundamental, ModalError> {
-    let mass = &mech.mass;
-    let modes = mechanisms(x0, mass, constrained);
-    if constrained.iter().all(|c| c.iter().all(|&b| b)) {
-        return Err(ModalError::Failed("every particle is constrained".into()));
-    }
     let mut op = LinearOperator::new(mech, x0);
     // Lanczos needs about as many steps as one CG solve (√ of the condition number, which
     // grows with (extent/L0)²): allow 100 per lattice spacing across the body.
     let max_steps = (100.0 * extent_in_spacings(mech, x0)) as usize + 2000;
+    lowest_mode(x0, &mech.mass, constrained, max_steps, |u, out| {
+        op.internal_forces(u, out)
+    })
+}
+
+/// The lowest mode of a body of points `x0` with masses, held in its `constrained`
+/// components, whose linearised internal forces at displacements u are `forces(u, out)`
+/// (−K·u): Lanczos on K with the rigid-body mechanisms the supports leave deflated.
+pub fn lowest_mode<const D: usize>(
+    x0: &[SVector<f64, D>],
+    mass: &[f64],
+    constrained: &[[bool; D]],
+    max_steps: usize,
+    mut forces: impl FnMut(&[SVector<f64, D>], &mut [SVector<f64, D>]),
+) -> Result<Fundamental, ModalError> {
+    let modes = mechanisms(x0, mass, constrained);
+    if constrained.iter().all(|c| c.iter().all(|&b| b)) {
+        return Err(ModalError::Failed("every particle is constrained".into()));
+    }
     let est = Lanczos {
         mass,
         constrained: Some(constrained),
@@ -203,7 +217,7 @@ pub fn fundamental<const D: usize, const K: usize>(
         max_steps,
     }
     .run(|u, out| {
-        op.internal_forces(u, out);
+        forces(u, out);
         out.iter_mut().for_each(|v| *v = -*v);
     });
     if !est.converged || est.eigenvalue.is_nan() || est.eigenvalue <= 0.0 {

@@ -113,27 +113,12 @@ mod tests {
         let c = micromodulus(37e9, delta, Body::Solid, Influence::Constant);
         let law = Softening::Linear { sc: 1e-3 };
         let bonds = Bonds::new(&grid, delta, c, law, correction);
-        let x0 = (0..grid.len())
-            .map(|p| {
-                let (i, j, k) = (p % n, (p / n) % n, p / (n * n));
-                Vector3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * DX
-            })
-            .collect();
+        let x0 = grid.points();
         (grid, bonds, x0)
     }
 
-    /// A pseudo-random displacement of size `a` (a fixed linear congruential sequence).
     fn jiggle(x0: &[Vector3<f64>], a: f64) -> Vec<Vector3<f64>> {
-        let mut r: u64 = 12345;
-        let mut next = || {
-            r = r
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (r >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        x0.iter()
-            .map(|p| p + Vector3::new(next(), next(), next()) * a)
-            .collect()
+        super::super::test_support::jiggle(x0, a, 12345)
     }
 
     /// At rest nothing pulls; under a homogeneous strain a point whose family is whole feels

@@ -42,6 +42,18 @@ impl CubicGrid {
         self.len() == 0
     }
 
+    /// The points' positions, point (i, j, k) at ((i + ½)Δx, (j + ½)Δx, (k + ½)Δx) with
+    /// index i + n0·(j + n1·k).
+    pub fn points(&self) -> Vec<nalgebra::Vector3<f64>> {
+        let [n0, n1, _] = self.n;
+        (0..self.len())
+            .map(|p| {
+                let (i, j, k) = (p % n0, (p / n0) % n1, p / (n0 * n1));
+                nalgebra::Vector3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * self.dx
+            })
+            .collect()
+    }
+
     /// The integer offsets within the horizon δ (excluding the point itself), with their
     /// partial-volume weights: the same stencil for every point of the grid.
     pub fn stencil(&self, delta: f64) -> Vec<([i64; 3], f64)> {

@@ -9,10 +9,6 @@ use super::body::BondBody;
 use nalgebra::SVector;
 use rayon::prelude::*;
 
-/// A parallel task: its first point, the forces of its points and their bonds' largest
-/// stretches.
-type Task<'a, const D: usize> = (usize, &'a mut [SVector<f64, D>], &'a mut [f32]);
-
 /// Points per parallel task: large enough that a task's bonds are a long stream.
 const CHUNK: usize = 512;
 
@@ -33,24 +29,31 @@ impl<const D: usize> BondBody<D> {
     /// break for good.
     pub fn forces(&mut self, x: &[SVector<f64, D>], f: &mut [SVector<f64, D>]) {
         let mut s_max = std::mem::take(&mut self.s_max);
-        let body = &*self;
-        let mut tasks: Vec<Task<'_, D>> = Vec::new();
-        let (mut f_rest, mut s_rest) = (f, &mut s_max[..]);
-        let mut i0 = 0;
-        while !f_rest.is_empty() {
-            let take = CHUNK.min(f_rest.len());
-            let bonds = (body.start[i0 + take] - body.start[i0]) as usize;
-            let (fa, fb) = f_rest.split_at_mut(take);
-            let (sa, sb) = s_rest.split_at_mut(bonds);
-            tasks.push((i0, fa, sa));
-            f_rest = fb;
-            s_rest = sb;
-            i0 += take;
-        }
-        tasks
-            .into_par_iter()
-            .for_each(|(i0, fs, smax)| body.chunk_forces(x, i0, fs, smax));
+        self.split_forces(x, 0, f, &mut s_max);
         self.s_max = s_max;
+    }
+
+    /// The forces on points i0.. (as many as `fs` holds), whose bonds' largest stretches are
+    /// `smax`: halved at a chunk boundary (with the bonds of each half) and the halves run in
+    /// parallel, down to chunks of [`CHUNK`] points; nothing is allocated.
+    fn split_forces(
+        &self,
+        x: &[SVector<f64, D>],
+        i0: usize,
+        fs: &mut [SVector<f64, D>],
+        smax: &mut [f32],
+    ) {
+        if fs.len() <= CHUNK {
+            return self.chunk_forces(x, i0, fs, smax);
+        }
+        let half = fs.len().div_ceil(2 * CHUNK) * CHUNK;
+        let bonds = (self.start[i0 + half] - self.start[i0]) as usize;
+        let (fa, fb) = fs.split_at_mut(half);
+        let (sa, sb) = smax.split_at_mut(bonds);
+        rayon::join(
+            || self.split_forces(x, i0, fa, sa),
+            || self.split_forces(x, i0 + half, fb, sb),
+        );
     }
 
     /// The forces on points i0.. (as many as `fs` holds), whose bonds' largest stretches
@@ -297,12 +300,11 @@ mod tests {
     const DX: f64 = 0.005;
 
     fn grid_points(n: usize) -> Vec<Vector3<f64>> {
-        (0..n * n * n)
-            .map(|p| {
-                let (i, j, k) = (p % n, (p / n) % n, p / (n * n));
-                Vector3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) * DX
-            })
-            .collect()
+        CubicGrid {
+            n: [n, n, n],
+            dx: DX,
+        }
+        .points()
     }
 
     fn law() -> Softening {
@@ -347,19 +349,7 @@ mod tests {
         BondBody::new(x0.clone(), vec![cell; x0.len()], s, Some(v0), &|_, _| true)
     }
 
-    /// A fixed pseudo-random displacement of size `a`.
-    fn jiggle(x0: &[Vector3<f64>], a: f64, seed: u64) -> Vec<Vector3<f64>> {
-        let mut r = seed;
-        let mut next = || {
-            r = r
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (r >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        x0.iter()
-            .map(|p| p + Vector3::new(next(), next(), next()) * a)
-            .collect()
-    }
+    use super::super::test_support::jiggle;
 
     /// The kernel's forces are the scalar reference's (`bonds.rs`, force densities) times
     /// each point's volume, to the single precision of the stored stiffness (1e-6), elastic

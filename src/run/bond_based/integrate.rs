@@ -3,11 +3,10 @@
 //! displacement loading of the scene's groups and velocity damping of the fundamental mode
 //! (`damping.external`, c = 2·ξ·ω1), recording the probe, the energies and the gauges.
 
-use super::{ramp_at, reaction, unstable_at, BondFinished};
+use super::{ramp_at, unstable_at, BondFinished};
 use crate::model::bond_based::body::BondBody;
 use crate::run::gauges::gauges_of;
 use crate::run::prepare::Prepared;
-use crate::run::RunOptions;
 use crate::solver::gauge::{readings, Gauge};
 use crate::solver::loading::Prescribed;
 use crate::solver::{Probe, Record};
@@ -129,7 +128,7 @@ impl<const D: usize> Stepper<D> {
             step: n,
             time_s: t,
             displacement_m: probe.amplitude * load,
-            force_n: reaction(probe, &self.f),
+            force_n: probe.reaction(&self.f),
             kinetic_j: kinetic,
             internal_j: self.body.elastic_energy(&self.x),
             external_work_j: self.external_work,
@@ -141,12 +140,7 @@ impl<const D: usize> Stepper<D> {
     /// Run to t_end with `output.records` records, stopping at an instability or after the
     /// peak (`loading.stop_after_peak`: the force below the fraction of its peak once a bond
     /// has broken).
-    pub fn run<const K: usize>(
-        &mut self,
-        p: &Prepared<K, D>,
-        _opts: &RunOptions,
-        start: Instant,
-    ) -> BondFinished {
+    pub fn run<const K: usize>(&mut self, p: &Prepared<K, D>, start: Instant) -> BondFinished {
         let scene = &p.model.scene;
         let empty = Probe {
             members: vec![],
