@@ -109,7 +109,6 @@ pub fn bond_body<const K: usize, const D: usize>(
         broken_bonds: 0,
         max_point_damage: 0.0,
         points_half_damaged: 0,
-        stopped_by: None,
     };
     Ok((body, report))
 }
@@ -213,6 +212,7 @@ where
     let dt = time_step(scene, stable.dt_stable)?;
     let t_end = loading_time(scene, fundamental.period);
     let steps = checked_steps(t_end, dt, body.len())?;
+    crate::run::load_test::check_judgeable(scene, t_end, dt)?;
     let probe = probe_of(scene, &model.groups);
     let p = Prepared {
         model,
@@ -258,7 +258,6 @@ where
     report.broken_bonds = body.broken_bonds();
     report.max_point_damage = phi.iter().cloned().fold(0.0, f64::max);
     report.points_half_damaged = phi.iter().filter(|&&f| f >= 0.5).count();
-    report.stopped_by = finished.stopped_by.clone();
     let damage: Vec<ParticleDamage> = phi
         .iter()
         .map(|&f| ParticleDamage {
@@ -301,6 +300,7 @@ where
         ));
     }
     summary.bond_based = Some(report);
+    summary.load_test = finished.load_test;
     let x0 = &p.model.particles.x0;
     let stress = stepper.stresses();
     Ok(Outcome {
@@ -335,7 +335,8 @@ pub struct BondFinished {
     pub steps_done: usize,
     pub failure: Option<Unstable>,
     pub stopped_after_peak: bool,
-    pub stopped_by: Option<String>,
+    /// The verdict of `[failure]` on a force-controlled load.
+    pub load_test: Option<crate::run::load_test::LoadTestReport>,
 }
 
 /// The instability of a step: the first point whose position is not finite.

@@ -3,6 +3,7 @@
 
 use super::dispatch::{dispatch, TypedRun};
 use super::generate::Generator;
+use super::load_test::LoadTestReport;
 use super::model::Model;
 use super::prepare::{prepare, Prepared};
 use super::recover::{Recover, Recovered};
@@ -150,6 +151,11 @@ pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> 
         integration,
     );
     sim.gauges = super::gauges::gauges_of(&p.model);
+    sim.applied = super::load_test::applied_forces(
+        &p.model.scene,
+        &p.model.groups,
+        &p.model.particles.volume,
+    );
     sim
 }
 
@@ -228,23 +234,20 @@ fn run_prepared<const K: usize, const D: usize>(
             .unwrap_or(p.model.scene.solver.safety * p.stable.dt_stable);
     }
     let mut sim = simulate(&mut p);
-    let empty_probe = Probe {
-        members: vec![],
-        component: 1,
-        amplitude: 0.0,
-    };
+    let empty_probe = Probe::empty();
     let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty_probe);
     let mut recorder = Recorder::of(&p, probe, recover);
     let mut increments = Vec::new();
+    let mut load_test = None;
     let (records, wall_s, failure, report) = match method {
         SolverMethod::Explicit => {
-            let (records, wall_s, failure, stopped) =
-                run_explicit(&mut sim, &p, probe, opts, start, recorder.as_mut());
+            let run = run_explicit(&mut sim, &p, probe, opts, start, recorder.as_mut());
             let report = SolverReport {
-                stopped_after_peak: stopped,
+                stopped_after_peak: run.stopped,
                 ..Default::default()
             };
-            (records, wall_s, failure, report)
+            load_test = run.load_test;
+            (run.records, run.wall_s, run.failure, report)
         }
         SolverMethod::Relaxation | SolverMethod::QuasiStatic => {
             let s = &p.model.scene.solver;
@@ -290,7 +293,7 @@ fn run_prepared<const K: usize, const D: usize>(
     let snapshots = recorder
         .map(|r| r.finish(&sim, &stress, damage.as_deref()))
         .unwrap_or_default();
-    let summary = summarise(
+    let mut summary = summarise(
         &p,
         &Finished {
             kernel: sim.kernel(),
@@ -305,6 +308,7 @@ fn run_prepared<const K: usize, const D: usize>(
         },
         damage.as_deref(),
     );
+    summary.load_test = load_test;
     let outcome = Outcome {
         summary,
         cells: p
@@ -336,8 +340,20 @@ fn run_prepared<const K: usize, const D: usize>(
     Ok(outcome)
 }
 
+/// What an explicit run hands to its summary.
+struct ExplicitRun {
+    records: Vec<Record>,
+    wall_s: Vec<f64>,
+    failure: Option<crate::solver::Unstable>,
+    /// Stopped after the peak (`loading.stop_after_peak`).
+    stopped: bool,
+    /// The verdict of `[failure]` on a force-controlled load.
+    load_test: Option<LoadTestReport>,
+}
+
 /// The explicit run to t_end with probe records (and the wall time at each), stopping at an
-/// instability, or after the peak with `loading.stop_after_peak` (then `true`). With an
+/// instability, after the peak with `loading.stop_after_peak`, or at the verdict of a
+/// `[failure]` criterion on a force-controlled load (docs/failure.md). With an
 /// adaptive pace (`loading.pace`) the records are spread over the load time τ and the run
 /// ends when τ reaches t_end. With `snapshots`, the frames due at each step's load time
 /// τ/t_end are taken (`run::snapshots`).
@@ -348,9 +364,12 @@ fn run_explicit<const K: usize, const D: usize>(
     opts: &RunOptions,
     start: Instant,
     mut snapshots: Option<&mut Recorder<K, D>>,
-) -> (Vec<Record>, Vec<f64>, Option<crate::solver::Unstable>, bool) {
+) -> ExplicitRun {
     let scene = &p.model.scene;
     let mut stop = PeakStop::new(scene.loading.stop_after_peak, probe);
+    let mut watch = super::load_test::watch(scene, p.t_end, sim.integration.dt);
+    let mut decision = None;
+    let t_ramp = sim.integration.t_ramp;
     let mut stopped = false;
     let wanted = scene.output.records;
     let every = (p.steps / (wanted - 1)).max(1);
@@ -403,6 +422,12 @@ fn run_explicit<const K: usize, const D: usize>(
             stopped = true;
             break;
         }
+        if let Some(w) = watch.as_mut().filter(|w| w.due(sim.step)) {
+            decision = w.observe(sim.step, sim.time() > t_ramp, &sim.failure_observation());
+            if decision.is_some() {
+                break;
+            }
+        }
         if let Some(b) = &bar {
             if n % 256 == 0 {
                 b.set_position(n as u64);
@@ -415,7 +440,17 @@ fn run_explicit<const K: usize, const D: usize>(
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    (records, wall_s, failure, stopped)
+    let load_test = watch.filter(|_| failure.is_none()).map(|w| {
+        let d = decision.unwrap_or_else(|| w.at_end(sim.step));
+        LoadTestReport::of(scene, &w, d, sim.integration.dt)
+    });
+    ExplicitRun {
+        records,
+        wall_s,
+        failure,
+        stopped,
+        load_test,
+    }
 }
 
 /// The controller of an adaptive pace (`loading.pace = "adaptive"`), `None` for the fixed
@@ -428,7 +463,7 @@ fn pacer<const K: usize, const D: usize>(p: &Prepared<K, D>, probe: &Probe) -> O
                 max: l.max_pace,
                 period: p.fundamental.period,
             },
-            if probe.amplitude < 0.0 { -1.0 } else { 1.0 },
+            probe.sign(),
         )
     })
 }

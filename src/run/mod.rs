@@ -18,6 +18,7 @@ pub mod dispatch;
 pub mod execute;
 pub mod gauges;
 pub mod generate;
+pub mod load_test;
 pub mod model;
 pub mod prepare;
 pub mod recover;

@@ -244,7 +244,7 @@ pub(crate) fn supports<const D: usize, const K: usize>(
             }));
         }
         let mut entries: Vec<(usize, f64)> = g.fix.iter().map(|a| (a.index(), 0.0)).collect();
-        if let Some(l) = &g.load {
+        if let Some(l) = g.load.as_ref().filter(|l| l.force.is_none()) {
             entries.push((l.component.index(), l.delta()));
         }
         for &i in &members {
@@ -270,6 +270,7 @@ pub(crate) fn supports<const D: usize, const K: usize>(
             members,
         });
     }
+    forces_on_free_components(scene, &groups, &constrained)?;
     let prescribed: Vec<Prescribed> = (0..n)
         .flat_map(|i| {
             let a = amplitude[i].clone();
@@ -283,4 +284,29 @@ pub(crate) fn supports<const D: usize, const K: usize>(
         })
         .collect();
     Ok((groups, constrained, prescribed))
+}
+
+/// Refuses a force-controlled load on a component that another group holds or moves.
+fn forces_on_free_components<const D: usize>(
+    scene: &Scene,
+    groups: &[groups::Group],
+    constrained: &[[bool; D]],
+) -> Result<(), RunError> {
+    for (g, spec) in groups.iter().zip(&scene.groups) {
+        let Some(l) = spec.load.as_ref().filter(|l| l.force.is_some()) else {
+            continue;
+        };
+        let c = l.component.index();
+        if let Some(&i) = g.members.iter().find(|&&i| constrained[i as usize][c]) {
+            return Err(RunError::Scene(crate::scene::SceneError::Invalid {
+                key: format!("groups.{}.load.force", g.name),
+                value: format!("{}", l.force.unwrap()),
+                allowed: format!(
+                    "a force on components no other group fixes or displaces: particle {i} of this group has its {} component held by another group",
+                    ["x", "y", "z"][c]
+                ),
+            }));
+        }
+    }
+    Ok(())
 }

@@ -169,6 +169,7 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
     let dt = time_step(scene, stable.dt_stable)?;
     let t_end = loading_time(scene, fundamental.period);
     let steps = checked_steps(t_end, dt, n)?;
+    super::load_test::check_judgeable(scene, t_end, dt)?;
     let probe = probe_of(scene, &model.groups);
 
     Ok(Prepared {
@@ -243,9 +244,9 @@ pub(crate) fn probe_of(
     })?;
     let spec = scene.groups.iter().find(|g| g.name == name)?;
     let members = groups.iter().find(|g| g.name == name)?.members.clone();
-    let (component, amplitude) = match &spec.load {
-        Some(l) => (l.component.index(), l.delta()),
-        None => (spec.fix[0].index(), 0.0),
+    let (component, amplitude, force) = match &spec.load {
+        Some(l) => (l.component.index(), l.delta(), l.force),
+        None => (spec.fix[0].index(), 0.0, None),
     };
     Some((
         name,
@@ -253,6 +254,7 @@ pub(crate) fn probe_of(
             members,
             component,
             amplitude,
+            force,
         },
     ))
 }

@@ -109,6 +109,8 @@ pub struct Summary {
     /// law and bonds; absent for the state-based lattice.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bond_based: Option<BondReport>,
+    /// A force-controlled load judged by `[failure]` (docs/failure.md): held or failed.
+    pub load_test: Option<super::load_test::LoadTestReport>,
     /// Random particles (SPPM): generation (count, distances, bond histogram, times), the
     /// minimum distance, and the micro-moduli residual statistics; absent for lattices.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -170,8 +172,6 @@ pub struct BondReport {
     /// points with φ ≥ 0.5.
     pub max_point_damage: f64,
     pub points_half_damaged: usize,
-    /// The rule that ended the run early (`loading.stop_rule`), if one did.
-    pub stopped_by: Option<String>,
 }
 
 /// The kinetic-to-elastic energy ratio around the peak below which a run counts as
@@ -407,11 +407,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         "completed"
     };
     let failure = failure.or(unconverged);
-    let sign = p
-        .probe
-        .as_ref()
-        .map(|(_, pr)| if pr.amplitude < 0.0 { -1.0 } else { 1.0 })
-        .unwrap_or(1.0);
+    let sign = p.probe.as_ref().map(|(_, pr)| pr.sign()).unwrap_or(1.0);
     let peak = records.iter().max_by(|a, b| {
         (sign * a.force_n)
             .partial_cmp(&(sign * b.force_n))
@@ -499,6 +495,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         kernel,
         surface_correction: p.model.surface.clone(),
         bond_based: None,
+        load_test: None,
         random_particles: p.model.random.as_ref().map(|r| RandomReport {
             generation: r.generation.clone(),
             micro_moduli: r.moduli.clone(),

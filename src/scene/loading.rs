@@ -4,7 +4,7 @@
 use super::Axis;
 use serde::{Deserialize, Serialize};
 
-/// Displacement loading of one component of a group.
+/// Loading of one component of a group: a displacement (the default) or a force.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
@@ -12,14 +12,23 @@ pub struct LoadSpec {
     pub component: Axis,
     /// Δmax (m): the displacement at the end of the ramp (signed). May be left out in a
     /// scene with `[concrete]`: it then defaults to +1.5·COD_c (tension, docs/model.md §10).
-    /// Always set after [`Scene::resolve`](super::Scene::resolve).
-    #[serde(default)]
+    /// Always set after [`Scene::resolve`](super::Scene::resolve) unless `force` is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub displacement: Option<f64>,
+    /// P (N): a force-controlled load instead, the group's total force at the end of the
+    /// ramp (signed), shared among its members by volume and held after the ramp
+    /// (docs/failure.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force: Option<f64>,
 }
 
 impl LoadSpec {
-    /// Δmax (m) after [`Scene::resolve`](super::Scene::resolve).
+    /// Δmax (m) after [`Scene::resolve`](super::Scene::resolve); 0 for a force-controlled
+    /// load (the group's component is then free).
     pub fn delta(&self) -> f64 {
+        if self.force.is_some() {
+            return 0.0;
+        }
         self.displacement.unwrap_or(f64::NAN)
     }
 }

@@ -6,6 +6,7 @@
 mod body;
 pub mod concrete;
 mod discretisation;
+pub mod failure;
 pub mod gauge;
 mod loading;
 pub mod model_family;
@@ -62,6 +63,9 @@ pub struct Scene {
     pub loading: LoadingSpec,
     #[serde(default)]
     pub damping: DampingSpec,
+    /// The criterion that judges a force-controlled load (`[failure]`, docs/failure.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure: Option<failure::FailureSpec>,
     #[serde(default)]
     pub solver: SolverSpec,
     /// The model family and the bond-based model's choices (`[model]`; default the

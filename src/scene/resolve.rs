@@ -73,11 +73,11 @@ impl Scene {
         self.record("E", e, "scene");
         for (gi, g) in self.groups.iter().enumerate() {
             if let Some(l) = &g.load {
-                if l.displacement.is_none() {
+                if l.displacement.is_none() && l.force.is_none() {
                     return Err(invalid(
                         format!("groups[{gi}].load.displacement"),
                         "(missing)",
-                        "give the displacement at the end of the ramp in m (it defaults to 1.5·COD_c only in a scene with [concrete])",
+                        "give the displacement at the end of the ramp in m (it defaults to 1.5·COD_c only in a scene with [concrete]), or load.force in N",
                     ));
                 }
             }
@@ -326,7 +326,7 @@ impl Scene {
     fn default_displacements(&mut self, cod_c: f64) {
         for gi in 0..self.groups.len() {
             if let Some(l) = &mut self.groups[gi].load {
-                if l.displacement.is_none() {
+                if l.displacement.is_none() && l.force.is_none() {
                     l.displacement = Some(1.5 * cod_c);
                     let key = format!("groups.{}.load.displacement", self.groups[gi].name);
                     self.record(

@@ -30,9 +30,46 @@ pub struct Prescribed {
     pub amplitude: f64,
 }
 
+/// One component of a force-controlled load on one particle (docs/failure.md).
+#[derive(Clone, Copy, Debug)]
+pub struct AppliedForce {
+    pub particle: u32,
+    pub component: u8,
+    /// The force at the end of the ramp (N).
+    pub amplitude: f64,
+}
+
+/// A group's total force P along `component` shared among its `members` by volume,
+/// b_i = P·V_i/ΣV (docs/failure.md).
+pub fn shared_by_volume(
+    members: &[u32],
+    volume: &[f64],
+    component: usize,
+    total: f64,
+) -> Vec<AppliedForce> {
+    let sum: f64 = members.iter().map(|&i| volume[i as usize]).sum();
+    members
+        .iter()
+        .map(|&i| AppliedForce {
+            particle: i,
+            component: component as u8,
+            amplitude: total * volume[i as usize] / sum,
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_shared_force_sums_to_the_groups_force_in_proportion_to_volume() {
+        let b = shared_by_volume(&[0, 2], &[1.0, 5.0, 3.0], 1, -8.0);
+        assert_eq!(b.len(), 2);
+        assert_eq!((b[0].particle, b[0].component), (0, 1));
+        assert!((b[0].amplitude + 2.0).abs() < 1e-15);
+        assert!((b[1].amplitude + 6.0).abs() < 1e-15);
+    }
 
     #[test]
     fn ramps_start_at_rest_and_end_at_full_load() {

@@ -1,6 +1,7 @@
 //! Time integration of a discretised specimen: the step kernel, displacement loading,
 //! probes (reaction force, energies) and the stability guard (docs/architecture.md, "Solver").
 
+pub mod failure;
 pub mod gauge;
 pub mod inelastic;
 pub mod kernel;
@@ -32,7 +33,7 @@ pub(crate) mod test_rng {
 }
 
 use kernel::State;
-use loading::{ramp_fraction, Prescribed};
+use loading::{ramp_fraction, AppliedForce, Prescribed};
 use mechanics::Mechanics;
 use nalgebra::SVector;
 
@@ -79,9 +80,11 @@ pub struct Integration {
 pub struct Record {
     pub step: usize,
     pub time_s: f64,
-    /// Prescribed displacement of the probe group (m).
+    /// Prescribed displacement of the probe group (m); for a force-controlled group, its
+    /// members' mean displacement.
     pub displacement_m: f64,
-    /// Reaction of the probe group along its component (N).
+    /// Reaction of the probe group along its component (N); for a force-controlled group,
+    /// the force applied to it.
     pub force_n: f64,
     pub kinetic_j: f64,
     pub internal_j: f64,
@@ -96,11 +99,57 @@ pub struct Record {
 pub struct Probe {
     pub members: Vec<u32>,
     pub component: usize,
-    /// Δmax of the group along the component (0 for a support).
+    /// Δmax of the group along the component (0 for a support or a force-controlled group).
     pub amplitude: f64,
+    /// P (N) of a force-controlled group (`load.force`), `None` otherwise.
+    pub force: Option<f64>,
 }
 
 impl Probe {
+    /// A probe that reads nothing (a scene without groups).
+    pub fn empty() -> Self {
+        Probe {
+            members: vec![],
+            component: 1,
+            amplitude: 0.0,
+            force: None,
+        }
+    }
+
+    /// +1, or −1 when the group is pushed in the negative direction (its displacement or
+    /// force is negative).
+    pub fn sign(&self) -> f64 {
+        if self.amplitude < 0.0 || self.force.is_some_and(|p| p < 0.0) {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
+    /// The probe's (displacement, force) with the ramp at `ramp` × its full value: the
+    /// prescribed displacement and the reaction (−Σ `f` on the members), or, for a
+    /// force-controlled group, its members' mean displacement and the applied force.
+    pub fn reading<const D: usize>(
+        &self,
+        ramp: f64,
+        x: &[SVector<f64, D>],
+        x0: &[SVector<f64, D>],
+        f: &[SVector<f64, D>],
+    ) -> (f64, f64) {
+        match self.force {
+            None => (self.amplitude * ramp, self.reaction(f)),
+            Some(p) => {
+                let c = self.component;
+                let sum: f64 = self
+                    .members
+                    .iter()
+                    .map(|&i| x[i as usize][c] - x0[i as usize][c])
+                    .sum();
+                (sum / self.members.len().max(1) as f64, p * ramp)
+            }
+        }
+    }
+
     /// The reaction of the group along its component: −Σ of the internal forces `f` on its
     /// members.
     pub fn reaction<const D: usize>(&self, f: &[SVector<f64, D>]) -> f64 {
@@ -136,7 +185,7 @@ impl PeakStop {
     pub fn new(fraction: Option<f64>, probe: &Probe) -> Self {
         PeakStop {
             fraction,
-            sign: if probe.amplitude < 0.0 { -1.0 } else { 1.0 },
+            sign: probe.sign(),
             peak: 0.0,
             need_failure: true,
         }
@@ -259,6 +308,8 @@ pub struct Simulation<const D: usize, const K: usize> {
     pub mech: Mechanics<D, K>,
     pub state: State<D>,
     pub prescribed: Vec<Prescribed>,
+    /// Force-controlled loads (`load.force`), ramped like the displacements.
+    pub applied: Vec<AppliedForce>,
     pub integration: Integration,
     pub step: usize,
     external_work: f64,
@@ -319,6 +370,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             mech,
             state,
             prescribed,
+            applied: Vec::new(),
             integration,
             step: 0,
             external_work: 0.0,
@@ -506,9 +558,9 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             c.before = c.now;
             c.now += (c.factor - 1.0) * dt;
         }
-        // Supports and displacement loading; work of the reactions (central rule).
-        let mut work = 0.0;
-        let mut work_half = 0.0;
+        // Force loading, then supports and displacement loading; work of the applied
+        // forces and of the reactions (central rule).
+        let (mut work, mut work_half) = self.apply_forces(r_now);
         for p in &self.prescribed {
             let (i, c) = (p.particle as usize, p.component as usize);
             let u_next = p.amplitude * r_next;
@@ -536,11 +588,13 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         }
         let rec = record.map(|probe| {
             let kinetic = self.kinetic_energy_mid();
+            let (displacement_m, force_n) =
+                probe.reading(r_now, &self.state.x, &self.x0, &self.state.force);
             Record {
                 step: self.step,
                 time_s: t,
-                displacement_m: probe.amplitude * r_now,
-                force_n: probe.reaction(&self.state.force),
+                displacement_m,
+                force_n,
                 kinetic_j: kinetic,
                 internal_j: self.internal_energy_now(),
                 external_work_j: self.external_work + work_half,
@@ -556,6 +610,71 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         std::mem::swap(&mut self.state.v, &mut self.state.v_next);
         self.step += 1;
         rec
+    }
+
+    /// Adds the force-controlled loads b_i = ramp·P_i to the step the kernel took from the
+    /// internal forces alone: (3.58) is linear in the drive, so the share of b_i is
+    /// Δv = Δt·b_i/(m_i·(g + h)) on v^{n+½} and Δt·Δv on x^{n+1}, with the particle damper's
+    /// work booked again for the new mid-step velocity. Returns the work of the loads over
+    /// the step and up to step n (central rule, b^n·½(x^{n+1} − x^{n−1}) and
+    /// b^n·½(x^n − x^{n−1})).
+    fn apply_forces(&mut self, ramp: f64) -> (f64, f64) {
+        let dt = self.integration.dt;
+        let (mut work, mut work_half) = (0.0, 0.0);
+        for a in &self.applied {
+            let (i, c) = (a.particle as usize, a.component as usize);
+            let b = a.amplitude * ramp;
+            let m = &self.mech;
+            let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
+            let g = 1.0 + dt * m.c_implicit[i] * m.inv_mass[i];
+            let dv = b * dt * m.inv_mass[i] / (g + h);
+            let v0 = self.state.v[i][c];
+            let v1 = self.state.v_next[i][c];
+            let (vm, vm_new) = (0.5 * (v0 + v1), 0.5 * (v0 + v1 + dv));
+            self.state.damping_work[i] += dt
+                * (m.c_ex[i] * (vm_new * vm_new - vm * vm)
+                    + m.c_implicit[i] * ((v1 + dv - v0) * vm_new - (v1 - v0) * vm));
+            self.state.v_next[i][c] = v1 + dv;
+            self.state.x_next[i][c] += dv * dt;
+            work += b * 0.5 * dt * (v0 + v1 + dv);
+            work_half += b * 0.5 * dt * v0;
+        }
+        (work, work_half)
+    }
+
+    /// What the failure criteria read after a step (docs/failure.md): the force-loaded
+    /// particles' speeds v^{n+½}, their out-of-balance forces at x^n and the power of the
+    /// loads, and the volume-weighted mean damage max(w_t, w_c) of the body.
+    pub fn failure_observation(&self) -> failure::Observation {
+        let ramp = self.ramp_at(self.time() - self.integration.dt);
+        let (mut speed, mut ratio, mut power, mut moved) = (0.0, 0.0, 0.0, 0.0);
+        for a in &self.applied {
+            let (i, c) = (a.particle as usize, a.component as usize);
+            let b = a.amplitude * ramp;
+            let v = self.state.v[i];
+            speed += v.norm();
+            moved += (self.state.x[i] - self.x0[i]).norm();
+            power += v[c] * b;
+            let mut out = self.state.force[i];
+            out[c] += b;
+            ratio += out.norm() / b.abs().max(f64::MIN_POSITIVE);
+        }
+        let n = self.applied.len().max(1) as f64;
+        let damage = self.inelastic.as_ref().map_or(0.0, |m| {
+            let (mut sum, mut mass) = (0.0, 0.0);
+            for (d, &mi) in m.damage().iter().zip(self.mech.mass.iter()) {
+                sum += mi * d.wt.max(d.wc);
+                mass += mi;
+            }
+            sum / mass
+        });
+        failure::Observation {
+            mean_speed: speed / n,
+            out_of_balance: ratio / n,
+            damage,
+            power,
+            mean_displacement: moved / n,
+        }
     }
 
     /// Kinetic energy of the free components at step n, v^n = ½(v^{n−½} + v^{n+½})

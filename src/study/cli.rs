@@ -100,6 +100,28 @@ pub enum StudyCommand {
         #[arg(long, default_value = "splm,sppm,bond_based")]
         families: String,
     },
+    /// The failure load under a force-controlled load: the geometric binary search of Ness
+    /// (2019) on the scene's one `load.force` group, each test judged by its [failure]
+    /// criterion (output/<scene>-bisection/bisection.csv, a row per test written as it
+    /// finishes, and bisection.json; the same command resumes).
+    Bisection {
+        scene: PathBuf,
+        /// The lower bound of the failure load (N, magnitude).
+        #[arg(long)]
+        lower: f64,
+        /// The upper bound (N, magnitude).
+        #[arg(long)]
+        upper: f64,
+        /// Stop when upper − lower is at most this (N).
+        #[arg(long)]
+        tolerance: f64,
+        /// Override a scene value in every run (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Study folder (default: output/<scene file stem>-bisection).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Combine the shard folders of one Monte Carlo study: realisations.csv,
     /// deterministic.csv and the size-effect report in --out.
     Merge {
@@ -278,6 +300,31 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
                 .filter(|r| r.contains(",failed,"))
                 .count();
             Ok(status(rows.len() - 1 - failed, rows.len() - 1))
+        }
+        StudyCommand::Bisection {
+            scene,
+            lower,
+            upper,
+            tolerance,
+            set,
+            out,
+        } => {
+            let out = out.unwrap_or_else(|| super::bisection::default_out(&scene));
+            let initial = super::bisection::Bracket { lower, upper };
+            let r = super::bisection::bisection(&scene, &set, &out, initial, tolerance)?;
+            crate::say!(
+                "failure load {:.4e} N: held {:.4e} N, failed {:.4e} N after {} tests ({})",
+                r.failure_load,
+                r.bracket.lower,
+                r.bracket.upper,
+                r.tests,
+                r.criterion
+            );
+            if let Some(w) = &r.warning {
+                eprintln!("warning: {w}");
+            }
+            crate::say!("wrote {}", out.join("bisection.json").display());
+            Ok(status(1, 1))
         }
         StudyCommand::Merge { dirs, out, partial } => {
             let merged = merge(&dirs, out, partial)?;

@@ -247,9 +247,5 @@ fn quote(text: &str) -> String {
 
 /// The default folder of the study of a scene.
 pub fn default_out(scene: &Path) -> PathBuf {
-    let stem = scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scene".into());
-    PathBuf::from("output").join(format!("{stem}-families"))
+    super::options::default_folder(scene, "families")
 }

@@ -12,8 +12,11 @@
 //!   merge; [`size_effect`]: the statistics and the size-effect fits;
 //!   [`size_effect_report`]: the size-effect table, JSON and plot.
 //! - [`pareto`]: run time against error (`benchmarks/pareto.rs`).
+//! - [`families`]: one specimen under each model family; [`bisection`]: the failure load
+//!   under a force-controlled load (docs/failure.md).
 
 pub mod angle_effect;
+pub mod bisection;
 pub mod cli;
 pub mod convergence;
 pub mod crack_kink;

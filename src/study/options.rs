@@ -1,6 +1,8 @@
-//! Parsing of the studies' command-line lists (comma-separated angles, spacings, sizes).
+//! Parsing of the studies' command-line lists (comma-separated angles, spacings, sizes), and
+//! the default folder of a study.
 
 use anyhow::bail;
+use std::path::{Path, PathBuf};
 
 /// The non-empty, trimmed items of a comma-separated option value.
 pub fn comma_items(text: &str) -> Vec<&str> {
@@ -27,4 +29,13 @@ pub fn parse_list(option: &str, text: &str) -> anyhow::Result<Vec<f64>> {
                 })
         })
         .collect()
+}
+
+/// The default folder of a study of a scene file: output/<file stem>-<study>.
+pub fn default_folder(scene: &Path, study: &str) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    PathBuf::from("output").join(format!("{stem}-{study}"))
 }

@@ -110,6 +110,14 @@ const GOLDEN: &[Golden] = &[
         steps: 73103,
         particles: 543,
     },
+    // force-controlled: the peak is the force held; the energy is the balance's error
+    Golden {
+        scene: "uniaxial_tension_load_test",
+        peak_force_n: 50000.0,
+        dissipated_energy_j: 9.030303409988255e-09,
+        steps: 15800,
+        particles: 543,
+    },
     // Random particles, the same numbers on 1 and 2 threads. Re-recorded when the
     // Voronoi cells were cut about their particle in one frame (the volumes moved in their
     // last bits; peak −6e-11 relative, energy +4e-13), when damaged neighbours left the
@@ -380,6 +388,11 @@ fn golden_uniaxial_compression() {
 #[test]
 fn golden_uniaxial_tension() {
     check("uniaxial_tension", "2");
+}
+
+#[test]
+fn golden_uniaxial_tension_load_test() {
+    check("uniaxial_tension_load_test", "2");
 }
 
 #[test]

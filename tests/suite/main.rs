@@ -21,6 +21,7 @@ mod force_law;
 mod fuzz_cli;
 mod golden;
 mod layering;
+mod load_control;
 mod montecarlo;
 mod outputs_agree;
 mod patch_and_newton;

@@ -16,8 +16,9 @@ use toml::Value;
 
 /// The scene's sections: an error message names a key when it contains `section.` (or starts
 /// with `name =`), or carries the deserialiser's field or path (`field \`x\``, `in \`x.y\``).
-const SECTIONS: [&str; 13] = [
+const SECTIONS: [&str; 14] = [
     "model",
+    "failure",
     "body",
     "gauges",
     "cutouts",
@@ -76,6 +77,7 @@ fn exercise(text: &str, full: bool) {
         members: vec![0],
         component: 1,
         amplitude: 0.0,
+        force: None,
     };
     for _ in 0..steps.min(20) {
         let r = sim.advance(Some(&probe)).unwrap();
@@ -693,6 +695,7 @@ safety = 0.513402571997595
         members: vec![0],
         component: 1,
         amplitude: 0.0,
+        force: None,
     };
     for _ in 0..200 {
         let r = sim.advance(Some(&probe)).unwrap();
@@ -746,6 +749,7 @@ safety = 0.4897296086666986
         members: vec![0],
         component: 1,
         amplitude: 0.0,
+        force: None,
     };
     for _ in 0..steps {
         let r = sim.advance(Some(&probe)).unwrap();

@@ -163,6 +163,7 @@ pub(crate) fn forced(
         members: vec![],
         component: 1,
         amplitude: 0.0,
+        force: None,
     };
     for _ in 0..max_steps {
         let rec = sim.advance(Some(&probe)).unwrap();
@@ -375,6 +376,7 @@ fn contrast_of_1000_in_e_between_neighbours() {
                 members: vec![],
                 component: 1,
                 amplitude: 0.0,
+                force: None,
             };
             let mut last = None;
             let mut failure = None;

@@ -163,6 +163,7 @@ fn energy_history(lagged: bool, periods: f64) -> (Vec<f64>, Option<String>, f64)
         members: vec![],
         component: 1,
         amplitude: 0.0,
+        force: None,
     };
     let mut energy = Vec::new();
     for n in 0..steps {

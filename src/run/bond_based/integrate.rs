@@ -6,9 +6,11 @@
 use super::{ramp_at, unstable_at, BondFinished};
 use crate::model::bond_based::body::BondBody;
 use crate::run::gauges::gauges_of;
+use crate::run::load_test::{applied_forces, watch, LoadTestReport};
 use crate::run::prepare::Prepared;
+use crate::solver::failure::Observation;
 use crate::solver::gauge::{readings, Gauge};
-use crate::solver::loading::Prescribed;
+use crate::solver::loading::{AppliedForce, Prescribed};
 use crate::solver::{Probe, Record};
 use nalgebra::SVector;
 use rayon::prelude::*;
@@ -26,6 +28,9 @@ pub struct Stepper<const D: usize> {
     pub f: Vec<SVector<f64, D>>,
     pub mass: Vec<f64>,
     prescribed: Vec<Prescribed>,
+    /// Force-controlled loads (`load.force`), and their velocity components before a step.
+    applied: Vec<AppliedForce>,
+    applied_v: Vec<f64>,
     /// Per point and component: integrated (not prescribed).
     free: Vec<[bool; D]>,
     /// c = 2·ξ_ex·ω1 (1/s).
@@ -45,6 +50,8 @@ impl<const D: usize> Stepper<D> {
             f: vec![SVector::zeros(); n],
             mass,
             prescribed: p.model.prescribed.clone(),
+            applied: applied_forces(&p.model.scene, &p.model.groups, &body.volume),
+            applied_v: Vec::new(),
             free: p
                 .model
                 .constrained
@@ -60,9 +67,15 @@ impl<const D: usize> Stepper<D> {
     }
 
     /// One step from t to t + Δt: the forces at the current positions (kept in `f`), then
-    /// the free components' velocities and positions, then the prescribed ones.
+    /// the free components' velocities and positions, then the applied forces' share, then
+    /// the prescribed components.
     fn step(&mut self, t: f64, dt: f64, scene: &crate::scene::Scene, t_end: f64) {
         self.body.forces(&self.x, &mut self.f);
+        self.applied_v.clear();
+        for a in &self.applied {
+            self.applied_v
+                .push(self.v[a.particle as usize][a.component as usize]);
+        }
         let h = 0.5 * self.damping * dt;
         let damping = self.damping;
         // per fixed chunk of points, summed in order: the same bits on any number of threads
@@ -98,6 +111,7 @@ impl<const D: usize> Stepper<D> {
             .collect();
         let work: f64 = work.iter().sum();
         self.damping_work += work;
+        self.apply_forces(ramp_at(scene, t, t_end), dt);
         let load = ramp_at(scene, t + dt, t_end);
         for pr in &self.prescribed {
             let (i, c) = (pr.particle as usize, pr.component as usize);
@@ -106,6 +120,51 @@ impl<const D: usize> Stepper<D> {
             self.external_work -= self.f[i][c] * du;
             self.v[i][c] = du / dt;
             self.x[i][c] = target;
+        }
+    }
+
+    /// The force-controlled loads b = ramp·P_i added to the step taken from the internal
+    /// forces (Euler–Cromer is linear in the force): Δv = Δt·b/(m·(1 + h)), with the
+    /// damper's work booked again for the new mid-step velocity and the loads' work
+    /// b·(x^{n+1} − x^n).
+    fn apply_forces(&mut self, ramp: f64, dt: f64) {
+        let h = 0.5 * self.damping * dt;
+        for (a, &v0) in self.applied.iter().zip(&self.applied_v) {
+            let (i, c) = (a.particle as usize, a.component as usize);
+            let b = a.amplitude * ramp;
+            let m = self.mass[i];
+            let dv = dt * b / (m * (1.0 + h));
+            let v1 = self.v[i][c];
+            let (mid, mid_new) = (0.5 * (v0 + v1), 0.5 * (v0 + v1 + dv));
+            self.damping_work += self.damping * m * (mid_new * mid_new - mid * mid) * dt;
+            self.v[i][c] = v1 + dv;
+            self.x[i][c] += dt * dv;
+            self.external_work += b * dt * (v1 + dv);
+        }
+    }
+
+    /// What the failure criteria read after a step (docs/failure.md): the loaded points'
+    /// speeds and out-of-balance forces, the power of the loads at `ramp`, and the share of
+    /// bonds broken.
+    fn failure_observation(&self, ramp: f64) -> Observation {
+        let (mut speed, mut ratio, mut power, mut moved) = (0.0, 0.0, 0.0, 0.0);
+        for a in &self.applied {
+            let (i, c) = (a.particle as usize, a.component as usize);
+            let b = a.amplitude * ramp;
+            speed += self.v[i].norm();
+            moved += (self.x[i] - self.body.x0[i]).norm();
+            power += self.v[i][c] * b;
+            let mut out = self.f[i];
+            out[c] += b;
+            ratio += out.norm() / b.abs().max(f64::MIN_POSITIVE);
+        }
+        let n = self.applied.len().max(1) as f64;
+        Observation {
+            mean_speed: speed / n,
+            out_of_balance: ratio / n,
+            damage: self.body.broken_bonds() as f64 / self.body.bonds().max(1) as f64,
+            power,
+            mean_displacement: moved / n,
         }
     }
 
@@ -124,11 +183,12 @@ impl<const D: usize> Stepper<D> {
             .zip(&self.mass)
             .map(|(v, m)| 0.5 * m * v.norm_squared())
             .sum();
+        let (displacement_m, force_n) = probe.reading(load, &self.x, &self.body.x0, &self.f);
         Record {
             step: n,
             time_s: t,
-            displacement_m: probe.amplitude * load,
-            force_n: probe.reaction(&self.f),
+            displacement_m,
+            force_n,
             kinetic_j: kinetic,
             internal_j: self.body.elastic_energy(&self.x),
             external_work_j: self.external_work,
@@ -142,13 +202,9 @@ impl<const D: usize> Stepper<D> {
     /// has broken).
     pub fn run<const K: usize>(&mut self, p: &Prepared<K, D>, start: Instant) -> BondFinished {
         let scene = &p.model.scene;
-        let empty = Probe {
-            members: vec![],
-            component: 1,
-            amplitude: 0.0,
-        };
+        let empty = Probe::empty();
         let probe = p.probe.as_ref().map(|(_, pr)| pr).unwrap_or(&empty);
-        let sign = if probe.amplitude < 0.0 { -1.0 } else { 1.0 };
+        let sign = probe.sign();
         let every = (p.steps / (scene.output.records - 1)).max(1);
         let mut out = BondFinished {
             records: Vec::with_capacity(scene.output.records + 1),
@@ -156,9 +212,12 @@ impl<const D: usize> Stepper<D> {
             steps_done: 0,
             failure: None,
             stopped_after_peak: false,
-            stopped_by: None,
+            load_test: None,
         };
         let mut peak = 0.0f64;
+        let mut watch = watch(scene, p.t_end, p.dt);
+        let mut decision = None;
+        let t_ramp = scene.loading.ramp_fraction * p.t_end;
         for n in 0..p.steps {
             let t = n as f64 * p.dt;
             self.step(t, p.dt, scene, p.t_end);
@@ -183,7 +242,18 @@ impl<const D: usize> Stepper<D> {
                     }
                 }
             }
+            if let Some(w) = watch.as_mut().filter(|w| w.due(n + 1)) {
+                let o = self.failure_observation(ramp_at(scene, t, p.t_end));
+                decision = w.observe(n + 1, t + p.dt > t_ramp, &o);
+                if decision.is_some() {
+                    break;
+                }
+            }
         }
+        out.load_test = watch.filter(|_| out.failure.is_none()).map(|w| {
+            let d = decision.unwrap_or_else(|| w.at_end(out.steps_done));
+            LoadTestReport::of(scene, &w, d, p.dt)
+        });
         out
     }
 

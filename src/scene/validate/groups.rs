@@ -123,6 +123,9 @@ impl Scene {
             }
         }
         if let Some(l) = &g.load {
+            if let Some(force) = l.force {
+                return self.validate_force_load(key, l, force, &fixed);
+            }
             finite(&format!("{key}.load.displacement"), l.delta())?;
             // a displacement beyond the body's size is no loading of a specimen (and at
             // 1e300 m the energies overflow)
@@ -177,4 +180,59 @@ fn select_box(key: &str, min: &[f64], max: &[f64], dim: usize) -> Result<(), Sce
         }
     }
     Ok(())
+}
+
+impl Scene {
+    /// A force-controlled load (`load.force`, docs/failure.md): a finite, non-zero force on a
+    /// free component, and a run that can hold it (the explicit solver, a fixed pace, no stop
+    /// after a peak of a displacement-controlled curve).
+    fn validate_force_load(
+        &self,
+        key: &str,
+        l: &crate::scene::LoadSpec,
+        force: f64,
+        fixed: &HashSet<usize>,
+    ) -> Result<(), SceneError> {
+        let k = format!("{key}.load.force");
+        if let Some(d) = l.displacement {
+            return Err(invalid(
+                format!("{key}.load.displacement"),
+                d,
+                "either load.displacement or load.force, not both",
+            ));
+        }
+        if !(force.is_finite() && force != 0.0) {
+            return Err(invalid(&k, force, "a finite, non-zero force in N (signed)"));
+        }
+        if fixed.contains(&l.component.index()) {
+            return Err(invalid(
+                format!("{key}.load.component"),
+                format!("{:?}", l.component).to_lowercase(),
+                "a component that is not also in fix",
+            ));
+        }
+        let method = self.solver.method;
+        if method.is_incremental() {
+            return Err(invalid(
+                &k,
+                force,
+                format!("a force-controlled load runs with solver.method = \"explicit\" only (this scene sets \"{}\"); use load.displacement", method.name()),
+            ));
+        }
+        if let Some(f) = self.loading.stop_after_peak {
+            return Err(invalid(
+                "loading.stop_after_peak",
+                f,
+                format!("no stop after the peak with a force-controlled load ({k}): a [failure] criterion decides when it has failed"),
+            ));
+        }
+        if self.loading.pace == crate::scene::Pace::Adaptive {
+            return Err(invalid(
+                "loading.pace",
+                "\"adaptive\"",
+                format!("\"fixed\" with a force-controlled load ({k})"),
+            ));
+        }
+        Ok(())
+    }
 }

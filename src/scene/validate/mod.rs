@@ -5,6 +5,7 @@
 mod body;
 mod cutouts;
 mod discretisation;
+mod failure;
 mod gauges;
 mod groups;
 mod loading;
@@ -128,6 +129,7 @@ impl Scene {
         self.validate_groups()?;
         self.validate_loading()?;
         self.validate_damping()?;
+        self.validate_failure()?;
         self.validate_solver()?;
         self.validate_model()?;
         self.validate_output()?;
