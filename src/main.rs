@@ -177,6 +177,20 @@ fn run_scene(
             s.displacement_at_peak_m,
             s.max_kinetic_to_internal_energy
         );
+        if let Some(t) = &s.load_test {
+            say!(
+                "load test ({}): {} at step {} ({:.4e} s): {}",
+                t.criterion,
+                if t.verdict == sppm::solver::failure::Verdict::Holds {
+                    "holds"
+                } else {
+                    "fails"
+                },
+                t.decided_at_step,
+                t.decided_at_s,
+                t.reason
+            );
+        }
         for w in &s.warnings {
             eprintln!("warning: {w}");
         }
