@@ -260,7 +260,7 @@ fn fcc_damage_kernel_carries_the_second_neighbour_modulus() {
     assert!(checked >= 11);
 }
 
-/// The acceptance for 3D concrete on the shipped tension prism (150 × 150 × 300 mm,
+/// The acceptance for 3D concrete on the shipped tension prism (150 × 150 × 300 mm,
 /// Table 1 concrete) at L0 = 15 mm: the peak within ±5% of f't·A, the dissipated energy
 /// within ±10% of G_f·A (the FCC crack band is calibrated on this prism at 10 and 15 mm,
 /// benchmarks/RESULTS.md "Concrete in 3D"), kinetic/internal energy ≤ 5% up to the peak, and

@@ -233,7 +233,7 @@ fn cylinders_and_prisms_carry_their_volume_and_3d_concrete_prepares() {
     assert!(sim.inelastic.is_some());
 }
 
-/// The acceptance: an elastic FCC block in uniaxial tension, its side faces free,
+/// The acceptance of the FCC lattice: an elastic FCC block in uniaxial tension, its side faces free,
 /// gives E and ν within 1% at 0° and two general rotations (W = 20·L0: the surface layer of
 /// clipped cells costs O(L0/W); measured 0.3–0.9%, benchmarks/RESULTS.md "FCC").
 #[test]

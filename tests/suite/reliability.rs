@@ -1,5 +1,5 @@
 //! Reliability, run side: bounded resources, no silent wrong results, outputs that are never
-//! lost or mixed (docs/reliability.md). Each test is the reproduction given in the issue,
+//! lost or mixed (docs/reliability.md). Each test is the reproduction of a reported failure,
 //! scaled down where it would be slow; resource tests assert the refusal before allocation.
 
 use crate::common;
@@ -166,7 +166,7 @@ fn an_unconverged_residual_accepted_by_the_scene_passes_with_a_warning() {
 
 #[test]
 fn energy_put_into_the_dampers_from_nowhere_stops_the_run() {
-    // the issue's run: 1.7e10 J in the dampers for 4.7e6 J of work, reported "completed".
+    // the reported run: 1.7e10 J in the dampers for 4.7e6 J of work, reported "completed".
     // It was on the source's lattice surface; with clipped Voronoi cells the same
     // run stays stable and balanced (26 kJ in the dampers for 4.76 MJ of work), so the test
     // keeps the surface of the run that broke.

@@ -95,7 +95,7 @@ fn random_tension_block_peak_energy_and_crack() {
 }
 
 /// The split cylinder on random particles (`lattices/split_cylinder_random.toml`, L0 = 3.5 mm)
-/// over three particle sets: the mean peak within ±10% of (5.6) (the acceptance;
+/// over three particle sets: the mean peak within ±10% of (5.6) (the acceptance of the random 2D concrete;
 /// measured +4.0% over 10 sets, CoV 6.5%), and in every set the crack runs along the loaded
 /// diameter: the principal axis of the particles with w_t ≥ 0.9 within 20° of vertical and
 /// their centroid within 20 mm of the axis (measured: the 10 sets of the study 62–110°, one
