@@ -126,9 +126,13 @@ type Admission<const D: usize> = Box<dyn Fn(&SVector<f64, D>, &SVector<f64, D>) 
 
 /// Whether a bond between two points stays in the scene's body: it crosses no notch, slit or
 /// hole and does not leave a non-convex outline (the body's own test of a lattice bond,
-/// with the outline sampled at eight points along the bond).
+/// with the outline sampled at eight points along the bond). A bond that only touches a
+/// notch, at its tip or along a face, is cut: the test's tolerance is negative, so the
+/// boundary belongs to the notch (docs/bond_based.md, "Notches": on a regular grid a notch
+/// tip midway between two rows lies on bonds, and Hobbs's own intersection test of a bond
+/// against a notch counts a touch as a cut).
 fn admission<const D: usize>(scene: &Scene) -> Admission<D> {
-    let tol = 1e-9 * scene.discretisation.spacing;
+    let tol = -1e-9 * scene.discretisation.spacing;
     if D == 3 {
         let solid = scene.solid();
         Box::new(move |a, b| {
