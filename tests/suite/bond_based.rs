@@ -99,14 +99,14 @@ fn the_gregoire_beams_reach_the_thesis_peaks() {
 }
 
 /// The kinks at the two tips of the centre-cracked slab's preset crack, measured on the
-/// points with φ ≥ 0.35 within 2δ of each tip.
-fn slab_kinks(beta: f64) -> [f64; 2] {
+/// points with φ ≥ 0.35 within 2δ of each tip, the scene run with `overrides`.
+fn slab_kinks(beta: f64, overrides: &[String]) -> [f64; 2] {
     use nalgebra::Vector2;
     let path = format!(
         "{}/lattices/slab_centre_crack_{beta}_bond_based.toml",
         env!("CARGO_MANIFEST_DIR")
     );
-    let scene = sppm::Scene::from_file(std::path::Path::new(&path), &[]).unwrap();
+    let scene = sppm::Scene::from_file(std::path::Path::new(&path), overrides).unwrap();
     let o = sppm::run::run(&scene, &sppm::run::RunOptions::default()).unwrap();
     let delta = o.summary.bond_based.as_ref().unwrap().horizon_m;
     let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
@@ -124,23 +124,24 @@ fn slab_kinks(beta: f64) -> [f64; 2] {
     got.map(|k| k.expect("a crack from each tip").angle_deg)
 }
 
-/// The centre-cracked slab of the extended model of concrete (Δx = 2.5 mm, δ = 10 mm): a
-/// crack normal to the pull grows straight on from both tips (maximum tangential stress
-/// theory: 0°, within 5°); a crack at 45° turns towards the normal of the pull, between the
-/// far field's 45° and the theory's initial 53.1° (within 5° of either end). The theory's
-/// 53.1° itself is not met at one tip (benchmarks/RESULTS.md, "Bond-based centre-cracked
-/// slab").
+/// The centre-cracked slab of the extended model of concrete, δ = 4·Δx: a crack normal to
+/// the pull grows straight on from both tips (maximum tangential stress theory: 0°, within
+/// 5°; Δx = 2.5 mm); a crack at 45° kinks by the theory's 53.1° (Erdogan & Sih 1963), within
+/// 5°, at both tips (Δx = 1.5 mm, the shipped scene; coarser grids turn less:
+/// benchmarks/RESULTS.md, "Bond-based centre-cracked slab"). The 45° run stops once the
+/// force has fallen to 0.8 of its peak: the kink within 2δ of the tips is made by then
+/// (the same angles as at 0.2, measured).
 #[test]
 #[cfg_attr(
     not(feature = "validation"),
     ignore = "validation: cargo test --release --features validation"
 )]
-fn the_slab_crack_grows_straight_in_mode_one_and_turns_in_mixed_mode() {
-    for k in slab_kinks(90.0) {
+fn the_slab_crack_grows_straight_in_mode_one_and_kinks_by_the_theorys_angle_in_mixed_mode() {
+    for k in slab_kinks(90.0, &[]) {
         assert!(k <= 5.0, "mode I kink {k:.1}°");
     }
-    for k in slab_kinks(45.0) {
-        assert!((40.0..=58.1).contains(&k), "mixed-mode kink {k:.1}°");
+    for k in slab_kinks(45.0, &["loading.stop_after_peak=0.8".into()]) {
+        assert!((k - 53.1).abs() <= 5.0, "mixed-mode kink {k:.1}°");
     }
 }
 

@@ -298,8 +298,8 @@ fn every_shipped_scene_has_a_golden_record() {
 /// `benchmarks/concrete_3d.sh`), and the tension prism's physics is asserted at 15 mm in
 /// `tests/suite/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
 /// random particles (3–4 min a run): its records are RESULTS.md's ("Notched tension prism").
-/// The bond-based beams (25 s each) are asserted against Hobbs's (2021) peaks, and the
-/// centre-cracked slabs (3 min each) against the kink of their crack, in
+/// The bond-based beams (25–45 s each) are asserted against Hobbs's (2021) peaks, and the
+/// centre-cracked slabs (3 and 10 min) against the kink of their crack, in
 /// `tests/suite/bond_based.rs`.
 const LONG: &[&str] = &[
     "beam_3pb_notch02_bond_based",
