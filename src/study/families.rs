@@ -100,8 +100,8 @@ pub const COLUMNS: &[&str] = &[
 /// The crack of a run: its points (w_t ≥ [`CRACK_PATH_DAMAGE`] for the lattice and random
 /// particles, φ ≥ [`BOND_CRACK_DAMAGE`] for the bond-based model) beyond
 /// [`CLEARANCE_SPACINGS`] spacings of a support or a loaded group (as the objectivity study
-/// counts them), their centroid in the x–y plane and, in 2D, their principal axis (°; NaN in
-/// 3D).
+/// counts them; in 3D the distance in space), their centroid in the x–y plane and, in 2D,
+/// their principal axis (°; NaN in 3D).
 pub fn crack_of(o: &Outcome) -> (usize, [f64; 2], f64) {
     let Some(d) = &o.damage else {
         return (0, [f64::NAN; 2], f64::NAN);
@@ -112,11 +112,19 @@ pub fn crack_of(o: &Outcome) -> (usize, [f64; 2], f64) {
         CRACK_PATH_DAMAGE
     };
     let x0: Vec<Vector2<f64>> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
-    let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    let mut wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    let distance = CLEARANCE_SPACINGS * o.scene.discretisation.spacing;
     let held = super::objectivity::held_points(o);
-    let clear = Clearance {
-        held: &held,
-        distance: CLEARANCE_SPACINGS * o.scene.discretisation.spacing,
+    let clear = if o.dim == 3 {
+        // in 3D the clearance is a distance in space: the x–y projections of a prism's
+        // loaded end faces cover its whole section
+        clear_in_space(o, &mut wt, distance);
+        Clearance::NONE
+    } else {
+        Clearance {
+            held: &held,
+            distance,
+        }
     };
     match crack_path(&x0, &wt, threshold, &clear) {
         Ok(p) => (
@@ -125,6 +133,29 @@ pub fn crack_of(o: &Outcome) -> (usize, [f64; 2], f64) {
             if o.dim == 2 { p.axis_deg } else { f64::NAN },
         ),
         Err(_) => (0, [f64::NAN; 2], f64::NAN),
+    }
+}
+
+/// Leaves out (damage 0) the particles within `distance` of a support or a loaded group in
+/// space, for a 3D run.
+fn clear_in_space(o: &Outcome, wt: &mut [f64], distance: f64) {
+    let held: Vec<[f64; 3]> = o
+        .scene
+        .groups
+        .iter()
+        .filter(|g| !g.fix.is_empty() || g.load.is_some())
+        .filter_map(|g| o.groups.iter().find(|m| m.name == g.name))
+        .flat_map(|g| g.members.iter().map(|&i| o.x0[i as usize]))
+        .collect();
+    let d2 = distance * distance;
+    for (i, w) in wt.iter_mut().enumerate() {
+        let p = o.x0[i];
+        let near = held
+            .iter()
+            .any(|h| (0..3).map(|c| (h[c] - p[c]) * (h[c] - p[c])).sum::<f64>() <= d2);
+        if *w > 0.0 && near {
+            *w = 0.0;
+        }
     }
 }
 
