@@ -6,9 +6,7 @@
 //! `lattices/slab_centre_crack_45_bond_based.toml` with the overrides and prints the angle of
 //! each tip's crack from the preset crack's line, and the wall time.
 
-use nalgebra::Vector2;
-use sppm::study::crack_kink::kinks;
-use sppm::study::families::BOND_CRACK_DAMAGE;
+use sppm::study::crack_kink::bond_based_kinks;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -21,19 +19,7 @@ fn main() {
     let scene = sppm::Scene::from_file(std::path::Path::new(&path), overrides).unwrap();
     let start = std::time::Instant::now();
     let o = sppm::run::run(&scene, &sppm::run::RunOptions::default()).unwrap();
-    let delta = o.summary.bond_based.as_ref().unwrap().horizon_m;
-    let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
-    let phi: Vec<f64> = o.damage.as_ref().unwrap().iter().map(|d| d.wt).collect();
-    let b = beta.to_radians();
-    let half = Vector2::new(b.cos(), b.sin()) * 0.02;
-    let centre = Vector2::new(0.25, 0.2);
-    let got = kinks(
-        &x0,
-        &phi,
-        (centre - half, centre + half),
-        BOND_CRACK_DAMAGE,
-        (0.0, 2.0 * delta),
-    );
+    let got = bond_based_kinks(&o);
     let angles: Vec<String> = got
         .iter()
         .map(|k| {

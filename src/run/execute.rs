@@ -440,10 +440,9 @@ fn run_explicit<const K: usize, const D: usize>(
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let load_test = watch.filter(|_| failure.is_none()).map(|w| {
-        let d = decision.unwrap_or_else(|| w.at_end(sim.step));
-        LoadTestReport::of(scene, &w, d, sim.integration.dt)
-    });
+    let load_test = watch
+        .filter(|_| failure.is_none())
+        .map(|w| LoadTestReport::of(scene, &w, decision, sim.step, sim.integration.dt));
     ExplicitRun {
         records,
         wall_s,

@@ -82,7 +82,16 @@ pub struct LoadTestReport {
 }
 
 impl LoadTestReport {
-    pub fn of(scene: &Scene, watch: &FailureWatch, decision: Decision, dt: f64) -> Self {
+    /// The report of a run that ended at `end_step` with the criterion's `decision`, or
+    /// without one (then the load was not held, [`FailureWatch::at_end`]).
+    pub fn of(
+        scene: &Scene,
+        watch: &FailureWatch,
+        decision: Option<Decision>,
+        end_step: usize,
+        dt: f64,
+    ) -> Self {
+        let decision = decision.unwrap_or_else(|| watch.at_end(end_step));
         let t = watch.tolerances;
         LoadTestReport {
             loads: scene

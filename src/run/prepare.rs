@@ -245,7 +245,8 @@ pub(crate) fn probe_of(
     let spec = scene.groups.iter().find(|g| g.name == name)?;
     let members = groups.iter().find(|g| g.name == name)?.members.clone();
     let (component, amplitude, force) = match &spec.load {
-        Some(l) => (l.component.index(), l.delta(), l.force),
+        Some(l) if l.force.is_some() => (l.component.index(), 0.0, l.force),
+        Some(l) => (l.component.index(), l.delta(), None),
         None => (spec.fix[0].index(), 0.0, None),
     };
     Some((

@@ -23,12 +23,9 @@ pub struct LoadSpec {
 }
 
 impl LoadSpec {
-    /// Δmax (m) after [`Scene::resolve`](super::Scene::resolve); 0 for a force-controlled
-    /// load (the group's component is then free).
+    /// Δmax (m) after [`Scene::resolve`](super::Scene::resolve); NaN for a force-controlled
+    /// load, which has none.
     pub fn delta(&self) -> f64 {
-        if self.force.is_some() {
-            return 0.0;
-        }
         self.displacement.unwrap_or(f64::NAN)
     }
 }

@@ -2,7 +2,9 @@
 //! once the load is fully applied, each decides whether the specimen holds the load or has
 //! failed; a load not judged held by the end of the run has failed (Ness 2019, §4.3).
 
+use super::loading::AppliedForce;
 use crate::scene::failure::{Criterion, FailureSpec};
+use nalgebra::SVector;
 use serde::Serialize;
 
 /// What a check reads from the run, over the force-loaded particles B.
@@ -19,6 +21,40 @@ pub struct Observation {
     pub power: f64,
     /// (1/|B|)·Σ_B |u_i| (m): how far the loaded particles have moved.
     pub mean_displacement: f64,
+}
+
+impl Observation {
+    /// The observation over the force-loaded particles `applied` at `ramp` × their load:
+    /// positions `x` (reference `x0`), velocities `v`, internal forces `f`; with the body's
+    /// damaged share `damage`.
+    pub fn of_loads<const D: usize>(
+        applied: &[AppliedForce],
+        ramp: f64,
+        (x, x0): (&[SVector<f64, D>], &[SVector<f64, D>]),
+        v: &[SVector<f64, D>],
+        f: &[SVector<f64, D>],
+        damage: f64,
+    ) -> Self {
+        let (mut speed, mut ratio, mut power, mut moved) = (0.0, 0.0, 0.0, 0.0);
+        for a in applied {
+            let (i, c) = (a.particle as usize, a.component as usize);
+            let b = a.amplitude * ramp;
+            speed += v[i].norm();
+            moved += (x[i] - x0[i]).norm();
+            power += v[i][c] * b;
+            let mut out = f[i];
+            out[c] += b;
+            ratio += out.norm() / b.abs().max(f64::MIN_POSITIVE);
+        }
+        let n = applied.len().max(1) as f64;
+        Observation {
+            mean_speed: speed / n,
+            out_of_balance: ratio / n,
+            damage,
+            power,
+            mean_displacement: moved / n,
+        }
+    }
 }
 
 /// The share of the body's smallest dimension beyond which loaded particles that have moved

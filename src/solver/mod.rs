@@ -646,35 +646,18 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     /// particles' speeds v^{n+½}, their out-of-balance forces at x^n and the power of the
     /// loads, and the volume-weighted mean damage max(w_t, w_c) of the body.
     pub fn failure_observation(&self) -> failure::Observation {
-        let ramp = self.ramp_at(self.time() - self.integration.dt);
-        let (mut speed, mut ratio, mut power, mut moved) = (0.0, 0.0, 0.0, 0.0);
-        for a in &self.applied {
-            let (i, c) = (a.particle as usize, a.component as usize);
-            let b = a.amplitude * ramp;
-            let v = self.state.v[i];
-            speed += v.norm();
-            moved += (self.state.x[i] - self.x0[i]).norm();
-            power += v[c] * b;
-            let mut out = self.state.force[i];
-            out[c] += b;
-            ratio += out.norm() / b.abs().max(f64::MIN_POSITIVE);
-        }
-        let n = self.applied.len().max(1) as f64;
-        let damage = self.inelastic.as_ref().map_or(0.0, |m| {
-            let (mut sum, mut mass) = (0.0, 0.0);
-            for (d, &mi) in m.damage().iter().zip(self.mech.mass.iter()) {
-                sum += mi * d.wt.max(d.wc);
-                mass += mi;
-            }
-            sum / mass
-        });
-        failure::Observation {
-            mean_speed: speed / n,
-            out_of_balance: ratio / n,
+        let damage = self
+            .inelastic
+            .as_ref()
+            .map_or(0.0, |m| m.mean_damage(&self.mech.mass));
+        failure::Observation::of_loads(
+            &self.applied,
+            self.ramp_at(self.time() - self.integration.dt),
+            (&self.state.x, &self.x0),
+            &self.state.v,
+            &self.state.force,
             damage,
-            power,
-            mean_displacement: moved / n,
-        }
+        )
     }
 
     /// Kinetic energy of the free components at step n, v^n = ½(v^{n−½} + v^{n+½})

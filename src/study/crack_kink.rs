@@ -2,6 +2,8 @@
 //! the maximum tangential stress theory predicts (Erdogan & Sih 1963: 0° in pure mode I,
 //! 53.1° when K_II = K_I, a crack at 45° to a uniaxial pull), measured on a run's damage.
 
+use crate::run::Outcome;
+use crate::scene::CutoutSpec;
 use nalgebra::Vector2;
 
 /// The growth from one tip of the preset crack.
@@ -14,6 +16,31 @@ pub struct Kink {
     pub angle_deg: f64,
     /// The damaged points the direction was fitted to.
     pub points: usize,
+}
+
+/// The kink at each tip of a bond-based run's preset crack, the scene's first slit, measured
+/// on the points with φ ≥ [`BOND_CRACK_DAMAGE`](super::families::BOND_CRACK_DAMAGE) within
+/// 2δ of the tip; `None` without a slit, without damage or at a tip without a crack.
+pub fn bond_based_kinks(o: &Outcome) -> [Option<Kink>; 2] {
+    let crack = o.scene.cutouts.iter().find_map(|c| match c {
+        CutoutSpec::Slit { start, end, .. } => Some((
+            Vector2::new(start[0], start[1]),
+            Vector2::new(end[0], end[1]),
+        )),
+        _ => None,
+    });
+    let (Some(d), Some(b), Some(crack)) = (&o.damage, &o.summary.bond_based, crack) else {
+        return [None, None];
+    };
+    let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
+    let phi: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    kinks(
+        &x0,
+        &phi,
+        crack,
+        super::families::BOND_CRACK_DAMAGE,
+        (0.0, 2.0 * b.horizon_m),
+    )
 }
 
 /// The kink at each tip of the preset crack from `start` to `end`: the line through the

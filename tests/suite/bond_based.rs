@@ -101,27 +101,14 @@ fn the_gregoire_beams_reach_the_thesis_peaks() {
 /// The kinks at the two tips of the centre-cracked slab's preset crack, measured on the
 /// points with φ ≥ 0.35 within 2δ of each tip, the scene run with `overrides`.
 fn slab_kinks(beta: f64, overrides: &[String]) -> [f64; 2] {
-    use nalgebra::Vector2;
     let path = format!(
         "{}/lattices/slab_centre_crack_{beta}_bond_based.toml",
         env!("CARGO_MANIFEST_DIR")
     );
     let scene = sppm::Scene::from_file(std::path::Path::new(&path), overrides).unwrap();
     let o = sppm::run::run(&scene, &sppm::run::RunOptions::default()).unwrap();
-    let delta = o.summary.bond_based.as_ref().unwrap().horizon_m;
-    let x0: Vec<_> = (0..o.x0.len()).map(|i| o.point2(i)).collect();
-    let phi: Vec<f64> = o.damage.as_ref().unwrap().iter().map(|d| d.wt).collect();
-    let b = beta.to_radians();
-    let half = Vector2::new(b.cos(), b.sin()) * 0.02;
-    let centre = Vector2::new(0.25, 0.2);
-    let got = sppm::study::crack_kink::kinks(
-        &x0,
-        &phi,
-        (centre - half, centre + half),
-        sppm::study::families::BOND_CRACK_DAMAGE,
-        (0.0, 2.0 * delta),
-    );
-    got.map(|k| k.expect("a crack from each tip").angle_deg)
+    sppm::study::crack_kink::bond_based_kinks(&o)
+        .map(|k| k.expect("a crack from each tip").angle_deg)
 }
 
 /// The centre-cracked slab of the extended model of concrete, δ = 4·Δx: a crack normal to

@@ -147,25 +147,14 @@ impl<const D: usize> Stepper<D> {
     /// speeds and out-of-balance forces, the power of the loads at `ramp`, and the share of
     /// bonds broken.
     fn failure_observation(&self, ramp: f64) -> Observation {
-        let (mut speed, mut ratio, mut power, mut moved) = (0.0, 0.0, 0.0, 0.0);
-        for a in &self.applied {
-            let (i, c) = (a.particle as usize, a.component as usize);
-            let b = a.amplitude * ramp;
-            speed += self.v[i].norm();
-            moved += (self.x[i] - self.body.x0[i]).norm();
-            power += self.v[i][c] * b;
-            let mut out = self.f[i];
-            out[c] += b;
-            ratio += out.norm() / b.abs().max(f64::MIN_POSITIVE);
-        }
-        let n = self.applied.len().max(1) as f64;
-        Observation {
-            mean_speed: speed / n,
-            out_of_balance: ratio / n,
-            damage: self.body.broken_bonds() as f64 / self.body.bonds().max(1) as f64,
-            power,
-            mean_displacement: moved / n,
-        }
+        Observation::of_loads(
+            &self.applied,
+            ramp,
+            (&self.x, &self.body.x0),
+            &self.v,
+            &self.f,
+            self.body.broken_bonds() as f64 / self.body.bonds().max(1) as f64,
+        )
     }
 
     /// `n` steps from rest (for timing), without records.
@@ -250,10 +239,9 @@ impl<const D: usize> Stepper<D> {
                 }
             }
         }
-        out.load_test = watch.filter(|_| out.failure.is_none()).map(|w| {
-            let d = decision.unwrap_or_else(|| w.at_end(out.steps_done));
-            LoadTestReport::of(scene, &w, d, p.dt)
-        });
+        out.load_test = watch
+            .filter(|_| out.failure.is_none())
+            .map(|w| LoadTestReport::of(scene, &w, decision, out.steps_done, p.dt));
         out
     }
 

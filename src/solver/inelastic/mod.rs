@@ -396,6 +396,9 @@ pub trait Inelastic<const D: usize, const K: usize>: Send + Sync {
     fn damage(&self) -> Vec<ParticleDamage>;
     /// Whether some particle has failed (w_t or w_c ≥ 0.99).
     fn has_failed_particle(&self) -> bool;
+    /// The mean of max(w_t, w_c) over the particles, weighted by `weights` (their masses:
+    /// the damaged share of the failure criteria, docs/failure.md); nothing is allocated.
+    fn mean_damage(&self, weights: &[f64]) -> f64;
     /// Hold the committed state through steps (`true`) or commit after every step (`false`,
     /// the explicit run); see [`DamageKernel::frozen`].
     fn set_frozen(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[nalgebra::SVector<f64, D>]);
@@ -471,6 +474,15 @@ where
     }
     fn has_failed_particle(&self) -> bool {
         self.committed.iter().any(|s| self.law.view(s).failed())
+    }
+    fn mean_damage(&self, weights: &[f64]) -> f64 {
+        let (mut sum, mut total) = (0.0, 0.0);
+        for (s, &w) in self.committed.iter().zip(weights) {
+            let d = self.law.view(s);
+            sum += w * d.wt.max(d.wc);
+            total += w;
+        }
+        sum / total
     }
     fn set_frozen(&mut self, frozen: bool, m: &Mechanics<D, K>, x: &[SVector<f64, D>]) {
         self.freeze(frozen, m, x)
