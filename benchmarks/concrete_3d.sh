@@ -3,8 +3,8 @@
 # peak force against its reference, the dissipated energy against G_f·A (tension prism), the
 # quasi-static ratio K/U up to the peak, the particles and the run time.
 # Usage: benchmarks/concrete_3d.sh [scene ...] [-- --set key=value ...]
-#   default scenes: tension_prism_3d split_cylinder_3d dogbone_B_3d beam_3pb_unnotched_3d
-#   beam_3pb_notch02_3d beam_3pb_notch05_3d
+#   default scenes: tension_prism_3d compression_prism_3d split_cylinder_3d dogbone_B_3d
+#   beam_3pb_unnotched_3d beam_3pb_notch02_3d beam_3pb_notch05_3d
 # Needs python3 to read summary.json. SPPM=path runs that binary instead of building;
 # OUT=dir keeps the outputs (default /tmp/sppm-concrete-3d).
 set -euo pipefail
@@ -13,7 +13,7 @@ scenes=()
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do scenes+=("$1"); shift; done
 [ "${1:-}" = "--" ] && shift
 if [ ${#scenes[@]} -eq 0 ]; then
-  scenes=(tension_prism_3d split_cylinder_3d dogbone_B_3d beam_3pb_unnotched_3d beam_3pb_notch02_3d beam_3pb_notch05_3d)
+  scenes=(tension_prism_3d compression_prism_3d split_cylinder_3d dogbone_B_3d beam_3pb_unnotched_3d beam_3pb_notch02_3d beam_3pb_notch05_3d)
 fi
 if [ -z "${SPPM:-}" ]; then
   cargo build --release --quiet
@@ -28,9 +28,10 @@ import json, math, sys
 s = json.load(open(sys.argv[1]))
 name = sys.argv[2]
 v = {d["key"]: d["value"] for d in s["material_values"]}
-# references: f't·A; (5.6); the dog-bone's f't·0.6·D·t; Hobbs's (2021) bond-based peaks
+# references: f't·A; f'c·A; (5.6); the dog-bone's f't·0.6·D·t; Hobbs's (2021) bond-based peaks
 ref = {
     "tension_prism_3d": v["ft"] * 0.15 * 0.15,
+    "compression_prism_3d": v["fc"] * 0.15 * 0.15,
     "split_cylinder_3d": math.pi / 2 * v["ft"] * 0.15 * 0.30 / (1 - (0.025 / 0.15) ** 2) ** 1.5,
     "dogbone_B_3d": v["ft"] * 0.6 * 0.1 * 0.1,
     "beam_3pb_unnotched_3d": 4748.0,

@@ -16,7 +16,7 @@ use crate::model::force_state::{dilatation_term, force_state};
 use crate::model::stress::StressSum;
 use crate::model::stretch::total_stretch;
 use crate::model::two_spring::TwoSpring;
-use crate::scene::{Pace, Scene, SolverMethod};
+use crate::scene::{CriteriaStrain, Pace, Scene, SolverMethod};
 use crate::solver::inelastic::DamageKernel;
 use crate::solver::mechanics::{weighted, Mechanics};
 use crate::solver::pace::{Observed, PaceSettings, Pacer};
@@ -117,8 +117,9 @@ where
 }
 
 /// The damage kernel of a model with `[concrete]`: the two-spring law with each particle's
-/// local properties (docs/model.md §12); random particles read their criteria over their
-/// neighbourhood. `None` without `[concrete]`.
+/// local properties (docs/model.md §12), its criteria read over each particle's neighbourhood
+/// (S.16) or on its own strain (`concrete.criteria_strain`, resolved per discretisation).
+/// `None` without `[concrete]`.
 pub fn damage_kernel<const K: usize, const D: usize>(
     model: &Model<K, D>,
 ) -> Option<DamageKernel<D, K>>
@@ -128,10 +129,13 @@ where
     let law = crate::model::damage::ConcreteLaw::from_scene(&model.scene)?;
     let local = properties::local_properties(&model.fields, &law, model.particles.len());
     let c = DamageKernel::new(TwoSpring::new(law, local), &model.particles);
-    Some(if model.random.is_some() {
-        c.with_neighbourhood_criteria(&model.particles)
-    } else {
-        c
+    let concrete = model.scene.concrete.as_ref()?;
+    Some(match concrete.criteria_strain {
+        Some(CriteriaStrain::Own) => c,
+        // set by `Scene::resolve`
+        Some(CriteriaStrain::Neighbourhood) | None => {
+            c.with_neighbourhood_criteria(&model.particles)
+        }
     })
 }
 

@@ -99,6 +99,8 @@ pub struct Summary {
     pub yielded_particles: Option<usize>,
     /// The concrete law used (every value resolved).
     pub concrete: Option<crate::model::damage::ConcreteLaw>,
+    /// The strain the concrete criteria read (docs/model.md §7): "neighbourhood" or "own".
+    pub criteria_strain: Option<crate::scene::CriteriaStrain>,
     /// Material values and where each came from (scene, preset or correlation).
     pub material_values: Vec<crate::scene::concrete::Derived>,
     pub force_lag: crate::scene::ForceLag,
@@ -490,6 +492,12 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         crushed_particles: damage.map(|d| d.iter().filter(|p| p.crushed()).count()),
         yielded_particles: damage.map(|d| d.iter().filter(|p| p.yielded).count()),
         concrete: crate::model::damage::ConcreteLaw::from_scene(&p.model.scene),
+        criteria_strain: p
+            .model
+            .scene
+            .concrete
+            .as_ref()
+            .and_then(|c| c.criteria_strain),
         material_values: p.model.scene.derived.clone(),
         force_lag: p.model.scene.solver.force_lag,
         kernel,

@@ -236,6 +236,16 @@ pub enum CrackOpening {
     Inelastic,
 }
 
+/// Which strain the concrete criteria (initiation, yield) read (docs/model.md §7, (S.16)).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CriteriaStrain {
+    /// The volume-weighted mean over the particle and its undamaged bonded neighbours (S.16).
+    Neighbourhood,
+    /// The particle's own least-squares strain (the source's pointwise criteria).
+    Own,
+}
+
 /// Concrete (docs/model.md §6–9, §11). Strengths in Pa, G_f in N/m (J/m²), lengths in m. A value
 /// left out comes from the preset, else from the correlation of §11, else the default shown.
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -294,6 +304,11 @@ pub struct ConcreteSpec {
     pub initiation: Initiation,
     #[serde(default = "default_crack_opening")]
     pub crack_opening: CrackOpening,
+    /// The strain initiation and yield read (docs/model.md §7): default the neighbourhood mean
+    /// (S.16) on random particles and the FCC lattice, each particle's own strain on the
+    /// hexagonal lattice. Always set after [`Scene::resolve`].
+    #[serde(default)]
+    pub criteria_strain: Option<CriteriaStrain>,
     /// Tensile damage (4.12–4.14); default on (off isolates plasticity, e.g. in tests).
     #[serde(default = "default_true")]
     pub tensile_damage: bool,

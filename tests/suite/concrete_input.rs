@@ -235,3 +235,29 @@ fn crack_band_defaults_by_discretisation() {
     assert_eq!(band(&random3), 4.2);
     assert_eq!(random3.derived_value("concrete.crack_band"), Some(4.2));
 }
+
+/// The criteria strain defaults by discretisation (docs/model.md §7): each particle's own on
+/// the hexagonal lattice, the neighbourhood mean on random particles and the FCC lattice; a
+/// scene value wins; a value that is neither is refused in its key.
+#[test]
+fn criteria_strain_defaults_by_discretisation() {
+    use sppm::scene::CriteriaStrain::{Neighbourhood, Own};
+    let criteria = |s: &Scene| s.concrete.as_ref().unwrap().criteria_strain.unwrap();
+    assert_eq!(criteria(&scene(&[]).unwrap()), Own);
+    let random = scene(&["discretisation.lattice=\"random\""]).unwrap();
+    assert_eq!(criteria(&random), Neighbourhood);
+    let given = scene(&["concrete.criteria_strain=\"neighbourhood\""]).unwrap();
+    assert_eq!(criteria(&given), Neighbourhood);
+    let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
+    let prism = |o: &[&str]| scene_of(&text, o).unwrap();
+    assert_eq!(criteria(&prism(&[])), Neighbourhood);
+    assert_eq!(criteria(&prism(&["concrete.criteria_strain=\"own\""])), Own);
+    assert_eq!(
+        criteria(&prism(&["discretisation.lattice=\"random\""])),
+        Neighbourhood
+    );
+    refused(
+        &["concrete.criteria_strain=\"mean\""],
+        &["criteria_strain", "neighbourhood", "own"],
+    );
+}

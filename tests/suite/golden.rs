@@ -295,8 +295,8 @@ fn every_shipped_scene_has_a_golden_record() {
 
 /// The 3D concrete scenes run 1–6 min each on this 2-core machine, beyond the
 /// suite's budget: their records are benchmarks/RESULTS.md's ("Concrete in 3D", by
-/// `benchmarks/concrete_3d.sh`), and the tension prism's physics is asserted at 15 mm in
-/// `tests/suite/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
+/// `benchmarks/concrete_3d.sh`), and the tension and compression prisms' physics is asserted
+/// in `tests/suite/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
 /// random particles (3–4 min a run): its records are RESULTS.md's ("Notched tension prism").
 /// The bond-based beams (25–45 s each) are asserted against Hobbs's (2021) peaks, and the
 /// centre-cracked slabs (3 and 10 min) against the kink of their crack, in
@@ -308,6 +308,7 @@ const LONG: &[&str] = &[
     "beam_3pb_notch02_3d",
     "beam_3pb_notch05_3d",
     "beam_3pb_unnotched_3d",
+    "compression_prism_3d",
     "dogbone_B_3d",
     "slab_centre_crack_45_bond_based",
     "slab_centre_crack_90_bond_based",
