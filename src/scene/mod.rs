@@ -305,8 +305,8 @@ pub struct ConcreteSpec {
     #[serde(default = "default_crack_opening")]
     pub crack_opening: CrackOpening,
     /// The strain initiation and yield read (docs/model.md §7): default the neighbourhood mean
-    /// (S.16) on random particles and the FCC lattice, each particle's own strain on the
-    /// hexagonal lattice. Always set after [`Scene::resolve`].
+    /// (S.16) on random particles, each particle's own strain on the lattices. Always set
+    /// after [`Scene::resolve`].
     #[serde(default)]
     pub criteria_strain: Option<CriteriaStrain>,
     /// Tensile damage (4.12–4.14); default on (off isolates plasticity, e.g. in tests).

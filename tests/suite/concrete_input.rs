@@ -237,8 +237,8 @@ fn crack_band_defaults_by_discretisation() {
 }
 
 /// The criteria strain defaults by discretisation (docs/model.md §7): each particle's own on
-/// the hexagonal lattice, the neighbourhood mean on random particles and the FCC lattice; a
-/// scene value wins; a value that is neither is refused in its key.
+/// the lattices, the neighbourhood mean on random particles; a scene value wins; a value that
+/// is neither is refused in its key.
 #[test]
 fn criteria_strain_defaults_by_discretisation() {
     use sppm::scene::CriteriaStrain::{Neighbourhood, Own};
@@ -250,8 +250,11 @@ fn criteria_strain_defaults_by_discretisation() {
     assert_eq!(criteria(&given), Neighbourhood);
     let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
     let prism = |o: &[&str]| scene_of(&text, o).unwrap();
-    assert_eq!(criteria(&prism(&[])), Neighbourhood);
-    assert_eq!(criteria(&prism(&["concrete.criteria_strain=\"own\""])), Own);
+    assert_eq!(criteria(&prism(&[])), Own);
+    assert_eq!(
+        criteria(&prism(&["concrete.criteria_strain=\"neighbourhood\""])),
+        Neighbourhood
+    );
     assert_eq!(
         criteria(&prism(&["discretisation.lattice=\"random\""])),
         Neighbourhood
