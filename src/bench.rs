@@ -359,7 +359,7 @@ pub fn bench_fcc(
 /// dampers on) under a homogeneous strain of 1e-4, or a damage kernel (`tension`, `full`) set
 /// up as [`bench_fcc`] sets it up (the Table 1 concrete under a triaxial strain of 0.9e-4, so
 /// that every particle initiates in the first step; each particle's own criteria strain, not
-/// the neighbourhood mean the random scenes read by default). The set-up's seconds (placement, clipped
+/// the neighbourhood mean the random scenes read). The set-up's seconds (placement, clipped
 /// Voronoi cells, bonds, moduli) are reported beside the throughput.
 pub fn bench_random3(
     particles: usize,

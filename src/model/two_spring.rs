@@ -4,7 +4,8 @@
 //!
 //! **Decision (criteria stress).** Initiation (§8) and yield (§9) use σ_c = D·ε_d of the
 //! particle, ε_d the least-squares strain (see `model::strain`) of its damaged elastic
-//! stretches d_ij·S_e,ij (by default its neighbourhood's mean, (S.16)), rather than (3.18). For an undamaged bulk particle the two are
+//! stretches d_ij·S_e,ij (or its neighbourhood's mean (S.16), `concrete.criteria_strain`),
+//! rather than (3.18). For an undamaged bulk particle the two are
 //! identical, and with damage they differ only by the d_ij on the b-term; but (3.18)
 //! under-reads at free surfaces (full ΔV, half the bonds) by up to ~60%, so cracks could
 //! neither start nor run through surface particles. The stress maps show the same D·ε of the
