@@ -118,7 +118,7 @@ where
 
 /// The damage kernel of a model with `[concrete]`: the two-spring law with each particle's
 /// local properties (docs/model.md §12), its criteria read over each particle's neighbourhood
-/// (S.16) or on its own strain (`concrete.criteria_strain`, resolved per discretisation).
+/// (S.16) or on its own strain ([`Scene::criteria_strain`]).
 /// `None` without `[concrete]`.
 pub fn damage_kernel<const K: usize, const D: usize>(
     model: &Model<K, D>,
@@ -129,13 +129,9 @@ where
     let law = crate::model::damage::ConcreteLaw::from_scene(&model.scene)?;
     let local = properties::local_properties(&model.fields, &law, model.particles.len());
     let c = DamageKernel::new(TwoSpring::new(law, local), &model.particles);
-    let concrete = model.scene.concrete.as_ref()?;
-    Some(match concrete.criteria_strain {
-        Some(CriteriaStrain::Own) => c,
-        // set by `Scene::resolve`
-        Some(CriteriaStrain::Neighbourhood) | None => {
-            c.with_neighbourhood_criteria(&model.particles)
-        }
+    Some(match model.scene.criteria_strain()? {
+        CriteriaStrain::Own => c,
+        CriteriaStrain::Neighbourhood => c.with_neighbourhood_criteria(&model.particles),
     })
 }
 

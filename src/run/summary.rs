@@ -492,12 +492,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         crushed_particles: damage.map(|d| d.iter().filter(|p| p.crushed()).count()),
         yielded_particles: damage.map(|d| d.iter().filter(|p| p.yielded).count()),
         concrete: crate::model::damage::ConcreteLaw::from_scene(&p.model.scene),
-        criteria_strain: p
-            .model
-            .scene
-            .concrete
-            .as_ref()
-            .and_then(|c| c.criteria_strain),
+        criteria_strain: p.model.scene.criteria_strain(),
         material_values: p.model.scene.derived.clone(),
         force_lag: p.model.scene.solver.force_lag,
         kernel,

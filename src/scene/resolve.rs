@@ -298,21 +298,36 @@ impl Scene {
         Ok(())
     }
 
-    /// The criteria strain (given, else the default of the discretisation, docs/model.md §7):
-    /// the neighbourhood mean (S.16) on random particles, each particle's own strain on the
-    /// lattices. The mean on the lattices was measured and is not their default: it moved
-    /// validated 2D results out of their tolerances and the FCC tension prism's energy at
-    /// 15 mm to 1.27 × G_f·A (benchmarks/RESULTS.md, "Criteria over the neighbourhood on
-    /// lattices").
+    /// The criteria strain the scene asks for, else the default of its discretisation
+    /// ([`Scene::criteria_strain`]), set in `[concrete]`.
     fn resolve_criteria_strain(&mut self) {
-        let default = if self.discretisation.is_random() {
-            CriteriaStrain::Neighbourhood
-        } else {
-            CriteriaStrain::Own
-        };
+        let default = self.default_criteria_strain();
         if let Some(cs) = self.concrete.as_mut() {
             cs.criteria_strain.get_or_insert(default);
         }
+    }
+
+    /// The criteria strain of the discretisation (docs/model.md §7): the neighbourhood mean
+    /// (S.16) on random particles, each particle's own strain on the lattices. The mean on the
+    /// lattices was measured and is not their default: it moved validated 2D results out of
+    /// their tolerances and the FCC tension prism's energy at 15 mm to 1.27 × G_f·A
+    /// (benchmarks/RESULTS.md, "Criteria over the neighbourhood on lattices").
+    fn default_criteria_strain(&self) -> CriteriaStrain {
+        if self.discretisation.is_random() {
+            CriteriaStrain::Neighbourhood
+        } else {
+            CriteriaStrain::Own
+        }
+    }
+
+    /// The strain the concrete criteria read: the scene's `concrete.criteria_strain`, else
+    /// the discretisation's default; `None` without `[concrete]`.
+    pub fn criteria_strain(&self) -> Option<CriteriaStrain> {
+        let c = self.concrete.as_ref()?;
+        Some(
+            c.criteria_strain
+                .unwrap_or_else(|| self.default_criteria_strain()),
+        )
     }
 
     /// The measured crack band of the scene's discretisation, and where it was measured.
