@@ -156,6 +156,7 @@ pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> 
         &p.model.groups,
         &p.model.particles.volume,
     );
+    sim.friction = super::platens::contacts(&p.model);
     sim
 }
 

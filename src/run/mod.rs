@@ -20,6 +20,7 @@ pub mod gauges;
 pub mod generate;
 pub mod load_test;
 pub mod model;
+pub mod platens;
 pub mod prepare;
 pub mod recover;
 pub mod snapshots;

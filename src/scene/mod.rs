@@ -354,6 +354,24 @@ pub struct GroupSpec {
     /// Displacement-controlled loading of this group.
     #[serde(default)]
     pub load: Option<LoadSpec>,
+    /// μ: the group is a platen with Coulomb friction (docs/model.md §10). Its normal is the
+    /// loaded component, or the one fixed component; its members slide along the other
+    /// components only where the tangential force exceeds μ times the platen's pressure.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+}
+
+impl GroupSpec {
+    /// The normal component of a platen (`friction`): the loaded component of a
+    /// displacement load, else the one component in `fix`; `None` when the group has neither.
+    pub fn platen_normal(&self) -> Option<usize> {
+        match &self.load {
+            Some(l) if l.force.is_none() => Some(l.component.index()),
+            Some(_) => None,
+            None if self.fix.len() == 1 => Some(self.fix[0].index()),
+            None => None,
+        }
+    }
 }
 
 /// A coordinate axis.

@@ -2,6 +2,7 @@
 //! probes (reaction force, energies) and the stability guard (docs/architecture.md, "Solver").
 
 pub mod failure;
+pub mod friction;
 pub mod gauge;
 pub mod inelastic;
 pub mod kernel;
@@ -310,6 +311,8 @@ pub struct Simulation<const D: usize, const K: usize> {
     pub prescribed: Vec<Prescribed>,
     /// Force-controlled loads (`load.force`), ramped like the displacements.
     pub applied: Vec<AppliedForce>,
+    /// Members of platens with friction (`groups.<name>.friction`).
+    pub friction: Vec<friction::Contact>,
     pub integration: Integration,
     pub step: usize,
     external_work: f64,
@@ -371,6 +374,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             state,
             prescribed,
             applied: Vec::new(),
+            friction: Vec::new(),
             integration,
             step: 0,
             external_work: 0.0,
@@ -586,6 +590,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
                 work_half += reaction * 0.5 * (p.amplitude * r_now - u_prev);
             }
         }
+        friction::apply(&self.friction, &self.mech, &mut self.state, dt);
         let rec = record.map(|probe| {
             let kinetic = self.kinetic_energy_mid();
             let (displacement_m, force_n) =

@@ -25,6 +25,7 @@ mod load_control;
 mod montecarlo;
 mod outputs_agree;
 mod patch_and_newton;
+mod platens;
 mod proptest_scenes;
 mod quasi_static;
 mod random_field;

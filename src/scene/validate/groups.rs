@@ -27,6 +27,7 @@ impl Scene {
             let key = format!("groups.{}", g.name);
             self.validate_selection(&key, &g.select)?;
             self.validate_supports_and_load(&key, g)?;
+            self.validate_friction(&key, g)?;
         }
         Ok(())
     }
@@ -231,6 +232,52 @@ impl Scene {
                 "loading.pace",
                 "\"adaptive\"",
                 format!("\"fixed\" with a force-controlled load ({k})"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// `friction` of a group (a platen, docs/model.md §10): a coefficient from 0 to 10 on a
+    /// group with one normal component (its displacement load, or one fixed axis), run by the
+    /// explicit solver of the SPLM/SPPM family.
+    fn validate_friction(&self, key: &str, g: &GroupSpec) -> Result<(), SceneError> {
+        let Some(mu) = g.friction else {
+            return Ok(());
+        };
+        let k = format!("{key}.friction");
+        if !(mu.is_finite() && (0.0..=10.0).contains(&mu)) {
+            return Err(invalid(
+                &k,
+                mu,
+                "a Coulomb coefficient from 0 (sliding freely) to 10",
+            ));
+        }
+        if g.platen_normal().is_none() {
+            return Err(invalid(
+                &k,
+                mu,
+                format!(
+                    "a platen: a group with a load.displacement (its component is the platen's normal) or with exactly one fixed axis; this group has fix = {:?}{}",
+                    g.fix,
+                    if g.load.is_some() { " and a force-controlled load" } else { "" }
+                ),
+            ));
+        }
+        let method = self.solver.method;
+        if method.is_incremental() {
+            return Err(invalid(
+                &k,
+                mu,
+                format!("platens with friction run with solver.method = \"explicit\" only (this scene sets \"{}\")", method.name()),
+            ));
+        }
+        if self.model.is_bond_based() {
+            return Err(invalid(
+                &k,
+                mu,
+                "platens with friction in the SPLM/SPPM family (this scene sets model.family = \"bond_based\")",
             ));
         }
         Ok(())
