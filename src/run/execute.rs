@@ -144,12 +144,16 @@ pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> 
         ramp: p.model.scene.loading.ramp,
         t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
     };
+    let bearings = super::platens::bearings(&p.model);
+    let prescribed =
+        super::platens::without_bearings(std::mem::take(&mut p.model.prescribed), &bearings);
     let mut sim = Simulation::new(
         p.model.particles.x0.clone(),
         std::mem::take(&mut p.model.mech),
-        std::mem::take(&mut p.model.prescribed),
+        prescribed,
         integration,
     );
+    sim.bearings = bearings;
     sim.gauges = super::gauges::gauges_of(&p.model);
     sim.applied = super::load_test::applied_forces(
         &p.model.scene,

@@ -7,6 +7,7 @@ use super::model::{check_size, Model};
 use super::RunError;
 use crate::material;
 use crate::scene::{BondScheme, Scene};
+use crate::solver::bearing::largest_rate;
 use crate::solver::mass_scaling::{scale_masses, MassScaling, MAX_ADDED_MASS};
 use crate::solver::time_step::{split_bond_dampers, stable_step, StableStep};
 use crate::solver::{modal, Probe};
@@ -166,6 +167,10 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
     stage("stable time step (largest frequency, Lanczos)");
     let mut stable = stable_step(&model.mech, &model.particles.x0);
     stable.implicit_share = share;
+    let bearings = super::platens::bearings(&model);
+    if !bearings.is_empty() {
+        stable.add_stiffness(largest_rate(&bearings, &model.mech.mass));
+    }
     let dt = time_step(scene, stable.dt_stable)?;
     let t_end = loading_time(scene, fundamental.period);
     let steps = checked_steps(t_end, dt, n)?;

@@ -147,6 +147,23 @@ impl CutoutSpec {
 }
 
 impl Scene {
+    /// The contact area of a strip selection (m²): its width times the length it runs along,
+    /// the thickness of a 2D body or the z extent of a prism or a cylinder along z; `None`
+    /// for other selections.
+    pub fn strip_area(&self, select: &super::Selection) -> Option<f64> {
+        let super::Selection::Strip { width, .. } = select else {
+            return None;
+        };
+        let length = match self.solid() {
+            None => self.material.thickness(),
+            Some(solid) => {
+                let (lo, hi) = solid.bounding_box();
+                hi.z - lo.z
+            }
+        };
+        Some(width * length)
+    }
+
     /// The body's smallest overall dimension (m).
     pub fn body_size(&self) -> f64 {
         shape_size(&self.body, &self.shape())

@@ -359,6 +359,20 @@ pub struct GroupSpec {
     /// components only where the tangential force exceeds μ times the platen's pressure.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
+    /// A bearing strip (plywood, hardboard) between the platen and the group's members: the
+    /// loaded component then moves the platen, which presses the members through the strip's
+    /// stiffness E/thickness per unit area (docs/model.md §10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bearing: Option<BearingSpec>,
+}
+
+/// A bearing strip of modulus `E` (Pa) and `thickness` (m) under a loading platen.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BearingSpec {
+    #[serde(rename = "E")]
+    pub e: f64,
+    pub thickness: f64,
 }
 
 impl GroupSpec {

@@ -1,6 +1,7 @@
 //! Time integration of a discretised specimen: the step kernel, displacement loading,
 //! probes (reaction force, energies) and the stability guard (docs/architecture.md, "Solver").
 
+pub mod bearing;
 pub mod failure;
 pub mod friction;
 pub mod gauge;
@@ -313,6 +314,8 @@ pub struct Simulation<const D: usize, const K: usize> {
     pub applied: Vec<AppliedForce>,
     /// Members of platens with friction (`groups.<name>.friction`).
     pub friction: Vec<friction::Contact>,
+    /// Members pressed through bearing strips (`groups.<name>.bearing`).
+    pub bearings: Vec<bearing::Bearing>,
     pub integration: Integration,
     pub step: usize,
     external_work: f64,
@@ -375,6 +378,7 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
             prescribed,
             applied: Vec::new(),
             friction: Vec::new(),
+            bearings: Vec::new(),
             integration,
             step: 0,
             external_work: 0.0,
@@ -565,6 +569,16 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
         // Force loading, then supports and displacement loading; work of the applied
         // forces and of the reactions (central rule).
         let (mut work, mut work_half) = self.apply_forces(r_now);
+        let (w, w_half) = bearing::apply(
+            &self.bearings,
+            &self.mech,
+            &self.x0,
+            &mut self.state,
+            r_now,
+            dt,
+        );
+        work += w;
+        work_half += w_half;
         for p in &self.prescribed {
             let (i, c) = (p.particle as usize, p.component as usize);
             let u_next = p.amplitude * r_next;

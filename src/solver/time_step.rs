@@ -40,6 +40,24 @@ pub struct StableStep {
     pub dt_stable: f64,
 }
 
+impl StableStep {
+    /// The limit with a diagonal stiffness added (bearing strips, `solver::bearing`) whose
+    /// largest k_i/m_i is `rate`: ω_max² grows by at most `rate` (Weyl's inequality), the
+    /// bond dampers' ratio falls with the higher ω_max, and (S.7) gives the step again.
+    pub fn add_stiffness(&mut self, rate: f64) {
+        let damping = 2.0 * self.zeta * self.omega_max;
+        self.omega_max = (self.omega_max * self.omega_max + rate).sqrt();
+        self.omega_max_bound = (self.omega_max_bound * self.omega_max_bound + rate).sqrt();
+        self.zeta = damping / (2.0 * self.omega_max);
+        let z = self.zeta;
+        self.dt_stable = if self.implicit_share != 0.0 {
+            2.0 / self.omega_max
+        } else {
+            2.0 / self.omega_max * ((1.0 + z * z).sqrt() - z)
+        };
+    }
+}
+
 /// Largest eigenvalue of M^{-1/2}·A·M^{-1/2}, all components free.
 fn largest<const D: usize>(
     mass: &[f64],

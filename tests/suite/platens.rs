@@ -173,3 +173,127 @@ fn bad_friction_is_refused_under_its_key() {
         );
     }
 }
+
+/// An elastic block 100 × 50 mm (hexagonal lattice, 5 mm) on a sliding base, its top row
+/// pushed down by 10 µm (`push` > 0 presses, < 0 pulls away) through a strip across the
+/// whole top, rigid or a bearing strip of E/thickness = `stiffness` (Pa/m).
+fn pressed_block(stiffness: Option<f64>, push: f64) -> sppm::run::Summary {
+    let bearing = stiffness.map_or(String::new(), |k| {
+        format!("bearing = {{ E = {:e}, thickness = 0.01 }}", k * 0.01)
+    });
+    let toml = format!(
+        r#"
+name = "pressed_block"
+[body]
+shape = "rectangle"
+width = 0.1
+height = 0.05
+[discretisation]
+spacing = 0.005
+[material]
+E = 30.0e9
+nu = 0.2
+rho = 2400.0
+thickness = 0.05
+[[groups]]
+name = "base"
+select = {{ by = "edge", edge = "bottom", rows = 1 }}
+fix = ["y"]
+[[groups]]
+name = "anchor"
+select = {{ by = "nearest", point = [0.05, 0.0] }}
+fix = ["x"]
+[[groups]]
+name = "platen"
+select = {{ by = "strip", edge = "top", width = 0.1, depth = 0.004 }}
+load = {{ component = "y", displacement = {d:e} }}
+{bearing}
+[loading]
+end_periods = 40.0
+ramp_fraction = 0.5
+[damping]
+internal = 0.2
+external = 0.5
+"#,
+        d = -push
+    );
+    let scene = Scene::from_toml_str(&toml, &[]).expect("valid scene");
+    let s = run(&scene, &RunOptions::default()).unwrap().summary;
+    assert_eq!(s.status, "completed");
+    s
+}
+
+/// A bearing strip is a spring in series with the block: with the block's stiffness K_b
+/// (rigid platen, F = K_b·Δ) and the strip's K_s = (E/t)·A, the platen's displacement Δ
+/// presses with F = Δ/(1/K_b + 1/K_s). Uniaxial compression on a sliding base is homogeneous
+/// under either platen (a uniform displacement or a uniform pressure), so the two agree up
+/// to the lattice's rows at the block's corners: within 1% for strips as stiff as the block
+/// and ten times stiffer. The strip pushes and never pulls: a platen drawn away carries
+/// nothing. The energy balance closes with the strip's work.
+#[test]
+fn a_bearing_strip_presses_in_series_with_the_block_and_never_pulls() {
+    let push = 1e-5;
+    let rigid = pressed_block(None, push).final_force_n;
+    let k_block = rigid / push;
+    let area = 0.1 * 0.05;
+    for factor in [1.0, 10.0] {
+        let k_strip = factor * k_block;
+        let s = pressed_block(Some(k_strip / area), push);
+        let series = push / (1.0 / k_block + 1.0 / k_strip);
+        assert!(
+            (s.final_force_n / series - 1.0).abs() < 0.01,
+            "strip {factor} × the block's stiffness: {} N, in series {series} N (rigid {rigid} N)",
+            s.final_force_n
+        );
+        assert!(
+            s.dissipated_energy_j.abs() < 1e-3 * s.external_work_j.abs(),
+            "unbooked energy {:e} J of {:e} J",
+            s.dissipated_energy_j,
+            s.external_work_j
+        );
+    }
+    let pulled = pressed_block(Some(k_block / area), -push);
+    assert!(
+        pulled.final_force_n.abs() < 1e-9 * rigid.abs(),
+        "a strip drawn away carries {} N",
+        pulled.final_force_n
+    );
+}
+
+/// Bad bearing strips are refused under `groups.<name>.bearing`, with what is allowed.
+#[test]
+fn bad_bearing_strips_are_refused_under_their_key() {
+    let path = Path::new("lattices/split_cylinder.toml");
+    for (sets, key, needle) in [
+        (
+            vec!["groups.top_strip.bearing={ E = -1e9, thickness = 0.003 }"],
+            "groups.top_strip.bearing.E",
+            "",
+        ),
+        (
+            vec![
+                "groups.top_strip.bearing={ E = 1e9, thickness = 0.003 }",
+                "groups.top_strip.friction=0.2",
+            ],
+            "groups.top_strip.bearing",
+            "either friction or a bearing strip",
+        ),
+    ] {
+        let sets: Vec<String> = sets.into_iter().map(String::from).collect();
+        let err = Scene::from_file(path, &sets)
+            .err()
+            .unwrap_or_else(|| panic!("{sets:?} accepted"))
+            .to_string();
+        assert!(err.contains(key) && err.contains(needle), "{sets:?}: {err}");
+    }
+    let path = Path::new("lattices/uniaxial_compression.toml");
+    let sets = vec!["groups.top.bearing={ E = 1e9, thickness = 0.003 }".to_string()];
+    let err = Scene::from_file(path, &sets)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        err.contains("groups.top.bearing") && err.contains("strip"),
+        "{err}"
+    );
+}

@@ -28,6 +28,7 @@ impl Scene {
             self.validate_selection(&key, &g.select)?;
             self.validate_supports_and_load(&key, g)?;
             self.validate_friction(&key, g)?;
+            self.validate_bearing(&key, g)?;
         }
         Ok(())
     }
@@ -278,6 +279,62 @@ impl Scene {
                 &k,
                 mu,
                 "platens with friction in the SPLM/SPPM family (this scene sets model.family = \"bond_based\")",
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// `bearing` of a group (a bearing strip, docs/model.md §10): a finite positive modulus
+    /// and thickness, on a strip selection with one normal component (its displacement load
+    /// or one fixed axis), without friction, run by the explicit solver of the SPLM/SPPM
+    /// family.
+    fn validate_bearing(&self, key: &str, g: &GroupSpec) -> Result<(), SceneError> {
+        let Some(b) = g.bearing else {
+            return Ok(());
+        };
+        let k = format!("{key}.bearing");
+        positive(&format!("{k}.E"), b.e)?;
+        positive(&format!("{k}.thickness"), b.thickness)?;
+        let text = format!("{{ E = {:e}, thickness = {} }}", b.e, b.thickness);
+        if self.strip_area(&g.select).is_none() {
+            return Err(invalid(
+                &k,
+                &text,
+                format!(
+                    "a group selected as a strip (select = {{ by = \"strip\", ... }}, whose width and length give the strip's area); this group selects {}",
+                    g.select.scene_text()
+                ),
+            ));
+        }
+        if g.platen_normal().is_none() {
+            return Err(invalid(
+                &k,
+                &text,
+                "a platen: a group with a load.displacement (its component is the platen's normal) or with exactly one fixed axis",
+            ));
+        }
+        if g.friction.is_some() {
+            return Err(invalid(
+                &k,
+                &text,
+                format!("either friction or a bearing strip on one group ({key} sets both)"),
+            ));
+        }
+        let method = self.solver.method;
+        if method.is_incremental() {
+            return Err(invalid(
+                &k,
+                &text,
+                format!("bearing strips run with solver.method = \"explicit\" only (this scene sets \"{}\")", method.name()),
+            ));
+        }
+        if self.model.is_bond_based() {
+            return Err(invalid(
+                &k,
+                &text,
+                "bearing strips in the SPLM/SPPM family (this scene sets model.family = \"bond_based\")",
             ));
         }
         Ok(())
