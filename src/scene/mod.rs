@@ -376,14 +376,28 @@ pub struct BearingSpec {
 }
 
 impl GroupSpec {
-    /// The normal component of a platen (`friction`): the loaded component of a
-    /// displacement load, else the one component in `fix`; `None` when the group has neither.
+    /// The normal component of a platen (`friction`, `bearing`): the axis normal to the
+    /// edge or face the group selects (by = "edge" or "strip") where the group fixes or
+    /// loads it, else the loaded component of a displacement load, else the one component
+    /// in `fix`; `None` when none of these names one.
     pub fn platen_normal(&self) -> Option<usize> {
-        match &self.load {
-            Some(l) if l.force.is_none() => Some(l.component.index()),
-            Some(_) => None,
-            None if self.fix.len() == 1 => Some(self.fix[0].index()),
-            None => None,
+        let displaced = self.load.as_ref().filter(|l| l.force.is_none());
+        let held = |c: usize| {
+            self.fix.iter().any(|a| a.index() == c)
+                || displaced.is_some_and(|l| l.component.index() == c)
+        };
+        let edge = match &self.select {
+            Selection::Edge { edge, .. } | Selection::Strip { edge, .. } => Some(*edge),
+            _ => None,
+        };
+        if let Some(c) = edge.map(Edge::axis).filter(|&c| held(c)) {
+            return Some(c);
+        }
+        match (&self.load, displaced) {
+            (_, Some(l)) => Some(l.component.index()),
+            (Some(_), None) => None,
+            (None, None) if self.fix.len() == 1 => Some(self.fix[0].index()),
+            (None, None) => None,
         }
     }
 }
@@ -420,6 +434,18 @@ pub enum Edge {
     Front,
     /// The face at the largest z (3D only).
     Back,
+}
+
+impl Edge {
+    /// The axis normal to the edge or face: y for bottom and top, x for left and right, z
+    /// for front and back.
+    pub fn axis(self) -> usize {
+        match self {
+            Edge::Bottom | Edge::Top => 1,
+            Edge::Left | Edge::Right => 0,
+            Edge::Front | Edge::Back => 2,
+        }
+    }
 }
 
 /// How the particles of a group are chosen.

@@ -260,7 +260,7 @@ impl Scene {
                 &k,
                 mu,
                 format!(
-                    "a platen: a group with a load.displacement (its component is the platen's normal) or with exactly one fixed axis; this group has fix = {:?}{}",
+                    "a platen: a group that selects an edge or a strip and fixes or displaces the axis normal to it, or one with a load.displacement or exactly one fixed axis (the platen's normal); this group has fix = {:?}{}",
                     g.fix,
                     if g.load.is_some() { " and a force-controlled load" } else { "" }
                 ),
@@ -312,7 +312,7 @@ impl Scene {
             return Err(invalid(
                 &k,
                 &text,
-                "a platen: a group with a load.displacement (its component is the platen's normal) or with exactly one fixed axis",
+                "a platen: a group that fixes or displaces the axis normal to its strip's edge",
             ));
         }
         if g.friction.is_some() {
