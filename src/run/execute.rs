@@ -132,6 +132,7 @@ where
     Some(match model.scene.criteria_strain()? {
         CriteriaStrain::Own => c,
         CriteriaStrain::Neighbourhood => c.with_neighbourhood_criteria(&model.particles),
+        CriteriaStrain::Surface => c.with_surface_criteria(&model.particles),
     })
 }
 

@@ -244,6 +244,9 @@ pub enum CriteriaStrain {
     Neighbourhood,
     /// The particle's own least-squares strain (the source's pointwise criteria).
     Own,
+    /// The mean (S.16) at surface particles (those with fewer bonds than the bulk), each
+    /// particle's own strain in the bulk.
+    Surface,
 }
 
 /// Concrete (docs/model.md §6–9, §11). Strengths in Pa, G_f in N/m (J/m²), lengths in m. A value

@@ -1,4 +1,4 @@
-//! Platens with Coulomb friction (docs/model.md §10, "Platens with friction"): a group's
+//! Platens with Coulomb friction (docs/model.md §10, (S.19)): a group's
 //! `friction = μ` lets its members slide along the platen's face only where the tangential
 //! force exceeds μ times the pressure the platen exerts on them.
 //!

@@ -248,6 +248,8 @@ fn criteria_strain_defaults_by_discretisation() {
     assert_eq!(criteria(&random), Neighbourhood);
     let given = scene(&["concrete.criteria_strain=\"neighbourhood\""]).unwrap();
     assert_eq!(criteria(&given), Neighbourhood);
+    let surface = scene(&["concrete.criteria_strain=\"surface\""]).unwrap();
+    assert_eq!(criteria(&surface), sppm::scene::CriteriaStrain::Surface);
     let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
     let prism = |o: &[&str]| scene_of(&text, o).unwrap();
     assert_eq!(criteria(&prism(&[])), Own);

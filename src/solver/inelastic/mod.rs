@@ -168,6 +168,9 @@ pub struct Neighbourhood<const D: usize> {
     strain_trial: Vec<Tensor<D>>,
     /// `strain` at the start of a quasi-static increment ([`DamageKernel::undo_increment`]).
     strain_start: Vec<Tensor<D>>,
+    /// Where the mean is read (`concrete.criteria_strain = "surface"`: the particles with
+    /// fewer bonds than the bulk); `None`: at every particle.
+    pub(super) only: Option<Vec<bool>>,
 }
 
 impl<const D: usize> Neighbourhood<D> {
@@ -244,8 +247,22 @@ where
             strain: vec![Tensor::<D>::zeros(); n],
             strain_trial: vec![Tensor::<D>::zeros(); n],
             strain_start: Vec::new(),
+            only: None,
         });
         self
+    }
+
+    /// The criteria read the neighbourhood's mean strain at surface particles (fewer bonds
+    /// than the most any particle has) and each particle's own strain in the bulk.
+    pub fn with_surface_criteria(self, p: &Particles<D, K>) -> Self {
+        let bonds = |i: usize| p.neighbours[i].iter().filter(|&&j| j != NONE).count();
+        let bulk = (0..p.len()).map(bonds).max().unwrap_or(0);
+        let surface = (0..p.len()).map(|i| bonds(i) < bulk).collect();
+        let mut c = self.with_neighbourhood_criteria(p);
+        if let Some(nb) = c.neighbourhood.as_mut() {
+            nb.only = Some(surface);
+        }
+        c
     }
 
     /// The step kernel this law needs: the tension kernel unless it needs plastic stretch and

@@ -252,9 +252,12 @@ where
             } else {
                 Dim::<D>::strain_tensor(&c.fit[i], &s.dse)
             };
-            Some(nb.mean(i, &m.neighbours[i], |j| {
-                c.law.view(&c.committed[j]).wt > 0.0
-            }))
+            let here = nb.only.as_ref().is_none_or(|only| only[i]);
+            here.then(|| {
+                nb.mean(i, &m.neighbours[i], |j| {
+                    c.law.view(&c.committed[j]).wt > 0.0
+                })
+            })
         }
         _ => None,
     };

@@ -461,6 +461,7 @@ fn neighbourhood_mean_weighs_by_volume_and_leaves_out_damaged_neighbours() {
         ],
         strain_trial: vec![Matrix2::zeros(); 3],
         strain_start: Vec::new(),
+        only: None,
     };
     let row = [1, NONE, 2];
     let all = nb.mean(0, &row, |_| false);
@@ -482,4 +483,39 @@ fn neighbourhood_mean_weighs_by_volume_and_leaves_out_damaged_neighbours() {
     // a damaged particle's own strain still counts
     let own = nb.mean(0, &row, |j| j != 0);
     assert!((own - nb.strain[0]).norm() < 1e-15);
+}
+
+/// `criteria_strain = "surface"` reads the mean where a particle misses bonds: on an FCC box
+/// those are exactly the particles within √2·L0 (the second neighbours' reach) of a face, and
+/// every other particle has the bulk's 18 bonds and reads its own strain.
+#[test]
+fn surface_criteria_read_the_mean_at_particles_missing_bonds_only() {
+    let l0 = 2e-3;
+    let size = nalgebra::Vector3::new(0.0133, 0.011, 0.015);
+    let p = crate::discretise::fcc::FccLattice {
+        spacing: l0,
+        rotation_deg: [0.0; 3],
+        offset: nalgebra::Vector3::repeat(0.25 * l0),
+    }
+    .fill(&crate::geometry::solid::Shape3::Box {
+        origin: nalgebra::Vector3::zeros(),
+        size,
+    });
+    let c = DamageKernel::new(law::<3>(true), &p).with_surface_criteria(&p);
+    let only = c.neighbourhood.as_ref().unwrap().only.as_ref().unwrap();
+    let (lo, hi) = p.x0.iter().fold(
+        (
+            nalgebra::Vector3::repeat(f64::MAX),
+            nalgebra::Vector3::repeat(f64::MIN),
+        ),
+        |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+    );
+    let reach = 2f64.sqrt() * l0 * (1.0 - 1e-9);
+    let mut surface = 0;
+    for (i, x) in p.x0.iter().enumerate() {
+        let near = (0..3).any(|d| x[d] - lo[d] < reach || hi[d] - x[d] < reach);
+        assert_eq!(only[i], near, "particle {i} at {x:?}");
+        surface += near as usize;
+    }
+    assert!(surface > 0 && surface < p.len(), "{surface} of {}", p.len());
 }
