@@ -289,8 +289,7 @@ fn bad_bearing_strips_are_refused_under_their_key() {
     let path = Path::new("lattices/uniaxial_compression.toml");
     let sets = vec!["groups.top.bearing={ E = 1e9, thickness = 0.003 }".to_string()];
     let err = Scene::from_file(path, &sets)
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(
         err.contains("groups.top.bearing") && err.contains("strip"),
