@@ -40,17 +40,14 @@ pub fn contacts<const K: usize, const D: usize>(model: &Model<K, D>) -> Vec<Cont
     out
 }
 
-/// Every bearing strip's members (`groups.<name>.bearing`). The platen's face lies at the
-/// group's outermost member along the normal; a member's gap is its reference distance from
-/// that face. The members within half their length scale of the face touch the strip: they
-/// share the strip's area (its width × the body's length along z, or the 2D thickness) by
-/// volume, each pressed by the strip's stiffness E/thickness over its share. Members deeper
-/// in (a second row, the particles under a curved face's strip edges that lie a row lower)
-/// take no force but are free along the normal like the others. The platen's Δmax is the
-/// group's load (0 for a fixed one).
+/// Every bearing strip's members (`groups.<name>.bearing`): the strip's stiffness per unit
+/// area E/thickness over its area (the strip's width × the body's length along z, or the 2D
+/// thickness), shared among the members by volume; the platen's Δmax is the group's load (0
+/// for a fixed one).
 pub fn bearings<const K: usize, const D: usize>(model: &Model<K, D>) -> Vec<Bearing> {
     let scene = &model.scene;
-    let p = &model.particles;
+    let x0 = &model.particles.x0;
+    let volume = &model.particles.volume;
     let mut out = Vec::new();
     for (spec, g) in scene.groups.iter().zip(&model.groups) {
         let (Some(b), Some(normal), Some(area)) = (
@@ -61,32 +58,13 @@ pub fn bearings<const K: usize, const D: usize>(model: &Model<K, D>) -> Vec<Bear
             continue;
         };
         let amplitude = spec.load.as_ref().map_or(0.0, |l| l.delta());
-        let inward = inward(&p.x0, &g.members, normal);
-        // the platen's face: the outermost member against the direction into the body
-        let face = g
-            .members
-            .iter()
-            .map(|&i| -inward * p.x0[i as usize][normal])
-            .fold(f64::NEG_INFINITY, f64::max)
-            * -inward;
-        let gap = |i: u32| inward * (p.x0[i as usize][normal] - face);
-        let touches = |i: u32| gap(i) < 0.5 * p.length[i as usize];
-        let total: f64 = g
-            .members
-            .iter()
-            .filter(|&&i| touches(i))
-            .map(|&i| p.volume[i as usize])
-            .sum();
+        let inward = inward(x0, &g.members, normal);
+        let total: f64 = g.members.iter().map(|&i| volume[i as usize]).sum();
         out.extend(g.members.iter().map(|&i| Bearing {
             particle: i,
             component: normal as u8,
             amplitude,
-            gap: gap(i),
-            stiffness: if touches(i) {
-                b.e / b.thickness * area * p.volume[i as usize] / total
-            } else {
-                0.0
-            },
+            stiffness: b.e / b.thickness * area * volume[i as usize] / total,
             inward,
         }));
     }

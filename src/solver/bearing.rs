@@ -1,11 +1,10 @@
-//! Bearing strips under a loading platen (docs/model.md §10, (S.20)): a group's
+//! Bearing strips under a loading platen (docs/model.md §10, "Bearing strips"): a group's
 //! `bearing = { E, thickness }` puts a strip of stiffness k'' = E/thickness per unit area
 //! between the platen and the members. The platen follows the group's displacement
-//! Δ(t); member i, of contact area A_i (the strip's area shared by volume among the members
-//! on the platen's face) and reference gap g_i to the face, is pressed by
+//! Δ(t); member i, of contact area A_i (the strip's area shared by volume), is pressed by
 //!
 //! ```text
-//! f_i = s·k''·A_i·max(0, s·(Δ(t) − u_i) − g_i)     (s = ±1: the direction into the body)
+//! f_i = s·k''·A_i·max(0, s·(Δ(t) − u_i))     (s = ±1: the direction into the body)
 //! ```
 //!
 //! along the platen's component: the strip pushes and never pulls. The force enters the
@@ -23,11 +22,8 @@ pub struct Bearing {
     pub component: u8,
     /// Δmax of the platen (m, signed).
     pub amplitude: f64,
-    /// k''·A_i (N/m): the strip's stiffness over the member's share of its area (0 for a
-    /// member that does not touch the strip).
+    /// k''·A_i (N/m): the strip's stiffness over the member's share of its area.
     pub stiffness: f64,
-    /// g_i (m): the member's reference distance from the platen's face.
-    pub gap: f64,
     /// +1 or −1: the direction along `component` that points into the body.
     pub inward: f64,
 }
@@ -47,7 +43,7 @@ pub fn apply<const D: usize, const K: usize>(
     for b in bearings {
         let (i, c) = (b.particle as usize, b.component as usize);
         let u = state.x[i][c] - x0[i][c];
-        let squeeze = (b.inward * (b.amplitude * ramp - u) - b.gap).max(0.0);
+        let squeeze = (b.inward * (b.amplitude * ramp - u)).max(0.0);
         let f = b.inward * b.stiffness * squeeze;
         if f == 0.0 {
             continue;
