@@ -227,6 +227,7 @@ where
         t_end,
         steps,
         probe,
+        bearings: Vec::new(),
     };
     Ok(BondPrepared {
         p,

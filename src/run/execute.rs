@@ -145,7 +145,7 @@ pub fn simulation_of<const K: usize, const D: usize>(p: &mut Prepared<K, D>) -> 
         ramp: p.model.scene.loading.ramp,
         t_ramp: p.model.scene.loading.ramp_fraction * p.t_end,
     };
-    let bearings = super::platens::bearings(&p.model);
+    let bearings = std::mem::take(&mut p.bearings);
     let prescribed =
         super::platens::without_bearings(std::mem::take(&mut p.model.prescribed), &bearings);
     let mut sim = Simulation::new(

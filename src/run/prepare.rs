@@ -7,7 +7,7 @@ use super::model::{check_size, Model};
 use super::RunError;
 use crate::material;
 use crate::scene::{BondScheme, Scene};
-use crate::solver::bearing::largest_rate;
+use crate::solver::bearing::{largest_rate, Bearing};
 use crate::solver::mass_scaling::{scale_masses, MassScaling, MAX_ADDED_MASS};
 use crate::solver::time_step::{split_bond_dampers, stable_step, StableStep};
 use crate::solver::{modal, Probe};
@@ -23,6 +23,9 @@ pub struct Prepared<const K: usize = 6, const D: usize = 2> {
     pub t_end: f64,
     pub steps: usize,
     pub probe: Option<(String, Probe)>,
+    /// The members pressed through bearing strips (`groups.<name>.bearing`), whose stiffness
+    /// the stable step takes.
+    pub bearings: Vec<Bearing>,
 }
 
 /// Discretise a scene with `generator` and assemble its model (body, groups, supports,
@@ -186,6 +189,7 @@ pub(crate) fn dynamics<const K: usize, const D: usize>(
         t_end,
         steps,
         probe,
+        bearings,
     })
 }
 

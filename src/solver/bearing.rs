@@ -8,10 +8,11 @@
 //! ```
 //!
 //! along the platen's component: the strip pushes and never pulls. The force enters the
-//! step as a force-controlled load does (the solver's `apply_forces`), and its work is the
+//! step as a force-controlled load does (`loading::add_force`), and its work is the
 //! work done on the specimen.
 
 use super::kernel::State;
+use super::loading::add_force;
 use super::mechanics::Mechanics;
 use nalgebra::SVector;
 
@@ -44,22 +45,12 @@ pub fn apply<const D: usize, const K: usize>(
         let (i, c) = (b.particle as usize, b.component as usize);
         let u = state.x[i][c] - x0[i][c];
         let squeeze = (b.inward * (b.amplitude * ramp - u)).max(0.0);
-        let f = b.inward * b.stiffness * squeeze;
-        if f == 0.0 {
+        if squeeze == 0.0 {
             continue;
         }
-        let h = 0.5 * dt * mech.c_ex[i] * mech.inv_mass[i];
-        let g = 1.0 + dt * mech.c_implicit[i] * mech.inv_mass[i];
-        let dv = f * dt * mech.inv_mass[i] / (g + h);
-        let (v0, v1) = (state.v[i][c], state.v_next[i][c]);
-        let (vm, vm_new) = (0.5 * (v0 + v1), 0.5 * (v0 + v1 + dv));
-        state.damping_work[i] += dt
-            * (mech.c_ex[i] * (vm_new * vm_new - vm * vm)
-                + mech.c_implicit[i] * ((v1 + dv - v0) * vm_new - (v1 - v0) * vm));
-        state.v_next[i][c] = v1 + dv;
-        state.x_next[i][c] += dv * dt;
-        work += f * 0.5 * dt * (v0 + v1 + dv);
-        work_half += f * 0.5 * dt * v0;
+        let (w, w_half) = add_force(mech, state, (i, c), b.inward * b.stiffness * squeeze, dt);
+        work += w;
+        work_half += w_half;
     }
     (work, work_half)
 }

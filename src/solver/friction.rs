@@ -19,6 +19,7 @@
 //! with the dampers' (`damping_energy_J`), so the energy balance of the run closes.
 
 use super::kernel::State;
+use super::loading::{add_force, damper_factor};
 use super::mechanics::Mechanics;
 use nalgebra::SVector;
 
@@ -36,6 +37,14 @@ pub struct Contact {
     pub mu: f64,
 }
 
+impl Contact {
+    /// The tangential components (bits of `tangential`).
+    fn components<const D: usize>(&self) -> impl Iterator<Item = usize> {
+        let bits = self.tangential;
+        (0..D).filter(move |&k| bits & (1 << k) != 0)
+    }
+}
+
 /// Adds the platens' friction forces to the step the kernel took (`state.v_next`,
 /// `state.x_next`, with the internal forces at x^n in `state.force`) and books their work,
 /// and the particle dampers' work at the new velocities, in `state.damping_work`.
@@ -49,32 +58,22 @@ pub fn apply<const D: usize, const K: usize>(
         let i = c.particle as usize;
         // the platen's push on the member: the reaction to the internal force, into the body
         let pressure = (-state.force[i][c.normal as usize] * c.inward).max(0.0);
-        let h = 0.5 * dt * mech.c_ex[i] * mech.inv_mass[i];
-        let g = 1.0 + dt * mech.c_implicit[i] * mech.inv_mass[i];
         // the force that stops the member's tangential motion over this step
-        let scale = (g + h) / (dt * mech.inv_mass[i]);
+        let scale = damper_factor(mech, i, dt) / (dt * mech.inv_mass[i]);
         let mut stop = SVector::<f64, D>::zeros();
-        for k in (0..D).filter(|&k| c.tangential & (1 << k) != 0) {
+        for k in c.components::<D>() {
             stop[k] = -scale * state.v_next[i][k];
         }
-        let norm = stop.norm();
-        let cap = c.mu * pressure;
-        let f = if norm <= cap || norm == 0.0 {
+        let (norm, cap) = (stop.norm(), c.mu * pressure);
+        let f = if norm <= cap {
             stop
         } else {
             stop * (cap / norm)
         };
-        for k in (0..D).filter(|&k| c.tangential & (1 << k) != 0) {
-            let dv = f[k] / scale;
-            let (v0, v1) = (state.v[i][k], state.v_next[i][k]);
-            let (vm, vm_new) = (0.5 * (v0 + v1), 0.5 * (v0 + v1 + dv));
-            // the dampers at the new mid-step velocity, and the friction's work (dissipated)
-            state.damping_work[i] += dt
-                * (mech.c_ex[i] * (vm_new * vm_new - vm * vm)
-                    + mech.c_implicit[i] * ((v1 + dv - v0) * vm_new - (v1 - v0) * vm))
-                - f[k] * dt * vm_new;
-            state.v_next[i][k] = v1 + dv;
-            state.x_next[i][k] += dv * dt;
+        for k in c.components::<D>() {
+            // the friction's work is dissipated: booked with the dampers'
+            let (work, _) = add_force(mech, state, (i, k), f[k], dt);
+            state.damping_work[i] -= work;
         }
     }
 }

@@ -1,6 +1,8 @@
 //! Displacement loading (docs/model.md §10): the 1−cos ramp (5.5) and the 5th-order smooth step
 //! (Hobbs (2021), Eq. 4.9), held at Δmax after t_ramp.
 
+use super::kernel::State;
+use super::mechanics::Mechanics;
 use crate::scene::Ramp;
 
 /// Fraction of Δmax applied at time t for a ramp ending at t_ramp.
@@ -37,6 +39,44 @@ pub struct AppliedForce {
     pub component: u8,
     /// The force at the end of the ramp (N).
     pub amplitude: f64,
+}
+
+/// g + h of particle i: a force f added after the kernel's step changes v^{n+½} by
+/// Δv = Δt·f/(m_i·(g + h)), (3.58) being linear in the drive, with the particle damper's h
+/// and the implicit bond dampers' g of (S.5), (S.17).
+#[inline]
+pub fn damper_factor<const D: usize, const K: usize>(
+    mech: &Mechanics<D, K>,
+    i: usize,
+    dt: f64,
+) -> f64 {
+    let h = 0.5 * dt * mech.c_ex[i] * mech.inv_mass[i];
+    let g = 1.0 + dt * mech.c_implicit[i] * mech.inv_mass[i];
+    g + h
+}
+
+/// Adds the force `f` on component `c` of particle i to the step the kernel took from the
+/// internal forces alone (force-controlled loads, bearing strips, friction): Δv on
+/// v^{n+½} ([`damper_factor`]) and Δt·Δv on x^{n+1}, with the dampers' work booked
+/// again for the new mid-step velocity. Returns the work of f over the step and up to step
+/// n (central rule, f·½(x^{n+1} − x^{n−1}) and f·½(x^n − x^{n−1})).
+#[inline]
+pub fn add_force<const D: usize, const K: usize>(
+    mech: &Mechanics<D, K>,
+    state: &mut State<D>,
+    (i, c): (usize, usize),
+    f: f64,
+    dt: f64,
+) -> (f64, f64) {
+    let dv = f * dt * mech.inv_mass[i] / damper_factor(mech, i, dt);
+    let (v0, v1) = (state.v[i][c], state.v_next[i][c]);
+    let (vm, vm_new) = (0.5 * (v0 + v1), 0.5 * (v0 + v1 + dv));
+    state.damping_work[i] += dt
+        * (mech.c_ex[i] * (vm_new * vm_new - vm * vm)
+            + mech.c_implicit[i] * ((v1 + dv - v0) * vm_new - (v1 - v0) * vm));
+    state.v_next[i][c] = v1 + dv;
+    state.x_next[i][c] += dv * dt;
+    (f * dt * vm_new, f * 0.5 * dt * v0)
 }
 
 /// A group's total force P along `component` shared among its `members` by volume,

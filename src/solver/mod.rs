@@ -632,31 +632,17 @@ impl<const D: usize, const K: usize> Simulation<D, K> {
     }
 
     /// Adds the force-controlled loads b_i = ramp·P_i to the step the kernel took from the
-    /// internal forces alone: (3.58) is linear in the drive, so the share of b_i is
-    /// Δv = Δt·b_i/(m_i·(g + h)) on v^{n+½} and Δt·Δv on x^{n+1}, with the particle damper's
-    /// work booked again for the new mid-step velocity. Returns the work of the loads over
-    /// the step and up to step n (central rule, b^n·½(x^{n+1} − x^{n−1}) and
-    /// b^n·½(x^n − x^{n−1})).
+    /// internal forces alone ([`loading::add_force`]). Returns the work of the loads over the
+    /// step and up to step n.
     fn apply_forces(&mut self, ramp: f64) -> (f64, f64) {
         let dt = self.integration.dt;
         let (mut work, mut work_half) = (0.0, 0.0);
         for a in &self.applied {
-            let (i, c) = (a.particle as usize, a.component as usize);
-            let b = a.amplitude * ramp;
-            let m = &self.mech;
-            let h = 0.5 * dt * m.c_ex[i] * m.inv_mass[i];
-            let g = 1.0 + dt * m.c_implicit[i] * m.inv_mass[i];
-            let dv = b * dt * m.inv_mass[i] / (g + h);
-            let v0 = self.state.v[i][c];
-            let v1 = self.state.v_next[i][c];
-            let (vm, vm_new) = (0.5 * (v0 + v1), 0.5 * (v0 + v1 + dv));
-            self.state.damping_work[i] += dt
-                * (m.c_ex[i] * (vm_new * vm_new - vm * vm)
-                    + m.c_implicit[i] * ((v1 + dv - v0) * vm_new - (v1 - v0) * vm));
-            self.state.v_next[i][c] = v1 + dv;
-            self.state.x_next[i][c] += dv * dt;
-            work += b * 0.5 * dt * (v0 + v1 + dv);
-            work_half += b * 0.5 * dt * v0;
+            let at = (a.particle as usize, a.component as usize);
+            let (w, w_half) =
+                loading::add_force(&self.mech, &mut self.state, at, a.amplitude * ramp, dt);
+            work += w;
+            work_half += w_half;
         }
         (work, work_half)
     }

@@ -8,12 +8,12 @@ use sppm::run::{run, RunOptions};
 use sppm::scene::Scene;
 use std::path::Path;
 
-/// An elastic block 100 × 50 mm (hexagonal lattice, 5 mm) on a base with friction μ, pressed
-/// down by a force P on its top row and pushed along x by its left column.
-fn sliding_block(mu: f64, press: f64) -> Scene {
-    let toml = format!(
+/// The scene `name` of an elastic block 100 × 50 mm (hexagonal lattice, 5 mm, 50 mm thick)
+/// up to its base, the bottom row held in y; the groups that follow are the caller's.
+fn block(name: &str) -> String {
+    format!(
         r#"
-name = "sliding_block"
+name = "{name}"
 [body]
 shape = "rectangle"
 width = 0.1
@@ -28,7 +28,15 @@ thickness = 0.05
 [[groups]]
 name = "base"
 select = {{ by = "edge", edge = "bottom", rows = 1 }}
-fix = ["y"]
+fix = ["y"]"#
+    )
+}
+
+/// An elastic block 100 × 50 mm (hexagonal lattice, 5 mm) on a base with friction μ, pressed
+/// down by a force P on its top row and pushed along x by its left column.
+fn sliding_block(mu: f64, press: f64) -> Scene {
+    let toml = format!(
+        r#"{header}
 friction = {mu}
 [[groups]]
 name = "press"
@@ -48,6 +56,7 @@ external = 0.0
 records = 400
 probe_group = "push"
 "#,
+        header = block("sliding_block"),
         force = -press
     );
     Scene::from_toml_str(&toml, &[]).expect("valid scene")
@@ -182,23 +191,7 @@ fn pressed_block(stiffness: Option<f64>, push: f64) -> sppm::run::Summary {
         format!("bearing = {{ E = {:e}, thickness = 0.01 }}", k * 0.01)
     });
     let toml = format!(
-        r#"
-name = "pressed_block"
-[body]
-shape = "rectangle"
-width = 0.1
-height = 0.05
-[discretisation]
-spacing = 0.005
-[material]
-E = 30.0e9
-nu = 0.2
-rho = 2400.0
-thickness = 0.05
-[[groups]]
-name = "base"
-select = {{ by = "edge", edge = "bottom", rows = 1 }}
-fix = ["y"]
+        r#"{header}
 [[groups]]
 name = "anchor"
 select = {{ by = "nearest", point = [0.05, 0.0] }}
@@ -215,6 +208,7 @@ ramp_fraction = 0.5
 internal = 0.2
 external = 0.5
 "#,
+        header = block("pressed_block"),
         d = -push
     );
     let scene = Scene::from_toml_str(&toml, &[]).expect("valid scene");

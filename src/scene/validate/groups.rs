@@ -266,19 +266,33 @@ impl Scene {
                 ),
             ));
         }
+        self.platens_run_here(&k, mu, "platens with friction")
+    }
+
+    /// A platen (friction, a bearing strip) under `key`, set to `value`, runs with the explicit
+    /// solver of the SPLM/SPPM family.
+    fn platens_run_here(
+        &self,
+        key: &str,
+        value: impl std::fmt::Display,
+        what: &str,
+    ) -> Result<(), SceneError> {
         let method = self.solver.method;
         if method.is_incremental() {
             return Err(invalid(
-                &k,
-                mu,
-                format!("platens with friction run with solver.method = \"explicit\" only (this scene sets \"{}\")", method.name()),
+                key,
+                value,
+                format!(
+                    "{what} run with solver.method = \"explicit\" only (this scene sets \"{}\")",
+                    method.name()
+                ),
             ));
         }
         if self.model.is_bond_based() {
             return Err(invalid(
-                &k,
-                mu,
-                "platens with friction in the SPLM/SPPM family (this scene sets model.family = \"bond_based\")",
+                key,
+                value,
+                format!("{what} in the SPLM/SPPM family (this scene sets model.family = \"bond_based\")"),
             ));
         }
         Ok(())
@@ -322,21 +336,6 @@ impl Scene {
                 format!("either friction or a bearing strip on one group ({key} sets both)"),
             ));
         }
-        let method = self.solver.method;
-        if method.is_incremental() {
-            return Err(invalid(
-                &k,
-                &text,
-                format!("bearing strips run with solver.method = \"explicit\" only (this scene sets \"{}\")", method.name()),
-            ));
-        }
-        if self.model.is_bond_based() {
-            return Err(invalid(
-                &k,
-                &text,
-                "bearing strips in the SPLM/SPPM family (this scene sets model.family = \"bond_based\")",
-            ));
-        }
-        Ok(())
+        self.platens_run_here(&k, &text, "bearing strips")
     }
 }
