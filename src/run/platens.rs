@@ -1,5 +1,6 @@
-//! The members of the scene's platens with friction (`groups.<name>.friction`, docs/model.md
-//! §10), for the solver's friction step (`solver::friction`).
+//! The members of the scene's platens with friction (`groups.<name>.friction`) and of its
+//! bearing strips (`groups.<name>.bearing`), docs/model.md §10, for the solver's steps
+//! (`solver::friction`, `solver::bearing`).
 
 use super::model::Model;
 use crate::solver::bearing::Bearing;
