@@ -147,6 +147,12 @@ fn bad_force_loads_and_criteria_are_refused_under_their_keys() {
         let e = refused(load, to);
         assert!(e.starts_with(key), "{key}: {e}");
     }
+    // far beyond E over the block's section (a strain of one): refused, not run to overflow
+    let e = refused(load, "load = { component = \"y\", force = 1.0e300 }");
+    assert!(
+        e.starts_with("groups.top.load.force = 1") && e.contains("strain of one"),
+        "{e}"
+    );
     let e = refused(
         "[failure]\ncriterion",
         "[solver]\nmethod = \"relaxation\"\n\n[failure]\ncriterion",

@@ -206,6 +206,18 @@ impl Scene {
         if !(force.is_finite() && force != 0.0) {
             return Err(invalid(&k, force, "a finite, non-zero force in N (signed)"));
         }
+        // E over the section on the body's smallest dimension is a strain of one: no loading
+        // of a specimen (and far beyond it the energies overflow within a few steps)
+        let size = self.body_size();
+        let section = size * if self.dim() == 3 { size } else { self.material.thickness() };
+        let largest = self.material.youngs_modulus() * section;
+        if force.abs() > largest {
+            return Err(invalid(
+                &k,
+                force,
+                format!("at most {largest:.4e} N in magnitude: E times a section of the body's smallest dimension by {} (a mean stress of E, a strain of one)", if self.dim() == 3 { "itself" } else { "material.thickness" }),
+            ));
+        }
         if fixed.contains(&l.component.index()) {
             return Err(invalid(
                 format!("{key}.load.component"),
