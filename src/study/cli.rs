@@ -191,6 +191,9 @@ pub fn dispatch(cmd: StudyCommand) -> anyhow::Result<ExitCode> {
             for line in report.crack_summary_lines() {
                 crate::say!("{line}");
             }
+            if let Some(line) = report.crack_band_line() {
+                crate::say!("{line}");
+            }
             if let Some(line) = report.angle_effect_line() {
                 crate::say!("{line}");
             }

@@ -4,7 +4,8 @@
 //! - [`runner`]: the generic parallel runner of scene variants and its CSV.
 //! - [`objectivity`]: lattice rotations and offsets (peak-force spread, crack path).
 //! - [`convergence`]: lattice spacings (Richardson reference and observed order).
-//! - [`crack_path`], [`extrapolation`]: the pure functions the studies report with;
+//! - [`crack_path`], [`crack_bands`], [`extrapolation`]: the pure functions the studies
+//!   report with;
 //!   [`angle_effect`]: whether per-angle means differ by more than their realisations' scatter.
 //! - [`plots`]: the overlay, convergence and size-effect plots; [`cli`]: the `sppm study`
 //!   command.
@@ -19,6 +20,7 @@ pub mod angle_effect;
 pub mod bisection;
 pub mod cli;
 pub mod convergence;
+pub mod crack_bands;
 pub mod crack_kink;
 pub mod crack_path;
 pub mod elastic_checks;

@@ -97,8 +97,11 @@ pub fn lattice_offset(
     [base[0] + u * a1x + v * a2x, base[1] + u * a1y + v * a2y]
 }
 
-/// The crack-path columns of the objectivity CSV.
-pub const CRACK_COLUMNS: [&str; 10] = [
+/// The crack-path columns of the objectivity CSV; the last three are a 3D run's cracks
+/// across its load axis ([`super::crack_bands`]): how many cross the section, and the
+/// position (share of the body's length along the axis) and coverage of the one that covers
+/// most of it.
+pub const CRACK_COLUMNS: [&str; 13] = [
     "cracked_particles",
     "crack_particles",
     "crack_axis_deg",
@@ -109,6 +112,9 @@ pub const CRACK_COLUMNS: [&str; 10] = [
     "crack_core_rms_width_m",
     "crack_core_centroid_x_m",
     "crack_core_centroid_y_m",
+    "cracks_across",
+    "crack_across_share",
+    "crack_across_coverage",
 ];
 
 /// The in-plane reference positions of the particles of the groups with prescribed
@@ -158,17 +164,51 @@ fn crack_metrics(o: &Outcome, threshold: f64) -> Vec<f64> {
     };
     let count = |t: f64| d.iter().filter(|p| p.wt >= t).count() as f64;
     let mut v = vec![count(super::crack_path::CRACKED), count(threshold)];
-    let Some(lines) = crack_lines(o, threshold) else {
-        v.extend([f64::NAN; 8]);
-        return v;
-    };
-    for line in lines {
-        match line {
-            Ok(p) => v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]]),
-            Err(_) => v.extend([f64::NAN; 4]),
+    match crack_lines(o, threshold) {
+        Some(lines) => {
+            for line in lines {
+                match line {
+                    Ok(p) => {
+                        v.extend([p.axis_deg, p.rms_width_m, p.centroid_m[0], p.centroid_m[1]])
+                    }
+                    Err(_) => v.extend([f64::NAN; 4]),
+                }
+            }
         }
+        None => v.extend([f64::NAN; 8]),
     }
+    v.extend(crack_band_metrics(o, threshold));
     v
+}
+
+/// A 3D run's cracks across the axis of its probe group's load: how many cross the section,
+/// and the share and coverage of the band that covers most of it (NaN where none does); all
+/// NaN in 2D, without damage or without a loaded probe.
+fn crack_band_metrics(o: &Outcome, threshold: f64) -> [f64; 3] {
+    let axis = o.summary.probe_group.as_ref().and_then(|name| {
+        let g = o.scene.groups.iter().find(|g| &g.name == name)?;
+        Some(g.load.as_ref()?.component.index())
+    });
+    let (Some(d), Some(axis), 3) = (&o.damage, axis, o.dim) else {
+        return [f64::NAN; 3];
+    };
+    let wt: Vec<f64> = d.iter().map(|p| p.wt).collect();
+    let bands = super::crack_bands::crack_bands(
+        &o.x0,
+        &wt,
+        threshold,
+        axis,
+        o.scene.discretisation.spacing,
+    );
+    let across = bands.iter().filter(|b| b.crosses()).count() as f64;
+    match bands
+        .iter()
+        .max_by(|a, b| a.coverage.total_cmp(&b.coverage))
+    {
+        Some(b) if b.crosses() => [across, b.share, b.coverage],
+        Some(b) => [across, f64::NAN, b.coverage],
+        None => [0.0, f64::NAN, 0.0],
+    }
 }
 
 /// Why a 2D run's crack path or core has no axis ([`NoCrack`]), for the run's message.
@@ -279,7 +319,44 @@ pub struct ObjectivityReport {
     pub dir: PathBuf,
 }
 
+/// The middle of a specimen's length along its load axis where a crack across it is away
+/// from the platens: the middle 60% (a test that breaks nearer a platen is discarded).
+pub const MIDDLE_SHARE: (f64, f64) = (0.2, 0.8);
+
 impl ObjectivityReport {
+    /// A 3D study's cracks across the load axis, one line: of the completed runs, how many
+    /// broke with exactly one crack across the section in the middle 60% of the length
+    /// ([`MIDDLE_SHARE`]), how many with two or more, and each run's crack positions; `None`
+    /// where no run has the columns (2D).
+    pub fn crack_band_line(&self) -> Option<String> {
+        let col = |name: &str| CRACK_COLUMNS.iter().position(|c| *c == name).unwrap();
+        let (n, share) = (col("cracks_across"), col("crack_across_share"));
+        let rows: Vec<_> = self
+            .rows
+            .iter()
+            .filter(|r| r.completed() && r.metrics.get(n).is_some_and(|x| x.is_finite()))
+            .collect();
+        if rows.is_empty() {
+            return None;
+        }
+        let middle = |x: f64| (MIDDLE_SHARE.0..=MIDDLE_SHARE.1).contains(&x);
+        let one = rows
+            .iter()
+            .filter(|r| r.metrics[n] == 1.0 && middle(r.metrics[share]))
+            .count();
+        let more = rows.iter().filter(|r| r.metrics[n] >= 2.0).count();
+        let none = rows.iter().filter(|r| r.metrics[n] == 0.0).count();
+        let each: Vec<String> = rows
+            .iter()
+            .map(|r| format!("{} {}×{:.2}", r.label, r.metrics[n], r.metrics[share]))
+            .collect();
+        Some(format!(
+            "cracks across the load axis: {one} of {} runs with one crack in the middle 60% of the length, {more} with two or more, {none} with none (run, cracks × position of the widest): {}",
+            rows.len(),
+            each.join(", ")
+        ))
+    }
+
     /// The per-angle means' spreads against the realisations' scatter, one line (where the
     /// study has at least two angles of two completed runs).
     pub fn angle_effect_line(&self) -> Option<String> {

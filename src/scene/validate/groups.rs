@@ -209,7 +209,12 @@ impl Scene {
         // E over the section on the body's smallest dimension is a strain of one: no loading
         // of a specimen (and far beyond it the energies overflow within a few steps)
         let size = self.body_size();
-        let section = size * if self.dim() == 3 { size } else { self.material.thickness() };
+        let section = size
+            * if self.dim() == 3 {
+                size
+            } else {
+                self.material.thickness()
+            };
         let largest = self.material.youngs_modulus() * section;
         if force.abs() > largest {
             return Err(invalid(
