@@ -117,7 +117,7 @@ def svg(env, runs, title, out):
     items += [(COLOURS[k % len(COLOURS)], label, None) for k, (label, _) in enumerate(runs)]
     for k, (c, text, dash) in enumerate(items):
         y = top + 12 + 17 * k
-        xl = w - right - 250
+        xl = w - right - 270
         if dash == "10":
             parts.append(f'<rect x="{xl}" y="{y - 6}" width="24" height="10" fill="{c}" fill-opacity="0.6"/>')
         else:
