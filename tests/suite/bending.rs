@@ -101,6 +101,57 @@ fn beam_groups_sit_where_their_scenes_say() {
     }
 }
 
+/// The 3D beams rest on rollers (docs/scenes.md, "Rollers"): each support and the load is
+/// one row of particles of one lattice plane, the outermost below or above (x = 25 and 150 mm below, 87.5 mm above),
+/// across the whole width, pressed by a bearing that pushes only; both supports hold as many
+/// particles (the lattice is symmetric about mid-span).
+#[test]
+fn beams_in_3d_rest_on_rollers_where_their_scenes_say() {
+    for f in [
+        "beam_3pb_unnotched_3d",
+        "beam_3pb_notch02_3d",
+        "beam_3pb_notch05_3d",
+    ] {
+        let path = format!("lattices/{f}.toml");
+        let scene = Scene::from_file(Path::new(&path), &[]).unwrap();
+        let m = sppm::run::prepare_model(&scene, sppm::run::Fcc).unwrap();
+        // the outermost lattice plane along y lies within half a pitch (L0/√2) of its face
+        let half_pitch = 0.5 * scene.discretisation.spacing / 2f64.sqrt();
+        let mut counts = Vec::new();
+        for (name, x, y) in [
+            ("left_support", 0.025, 0.0),
+            ("right_support", 0.15, 0.0),
+            ("load", 0.0875, 0.05),
+        ] {
+            let spec = scene.groups.iter().find(|g| g.name == name).unwrap();
+            assert!(spec.bearing.is_some(), "{f} {name}: no bearing");
+            let g = m.groups.iter().find(|g| g.name == name).unwrap();
+            let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
+            for &i in &g.members {
+                let p = m.particles.x0[i as usize];
+                assert!(
+                    (p[0] - x).abs() < 1e-6 && (p[1] - y).abs() < half_pitch,
+                    "{f} {name}: particle at {p:?}"
+                );
+                zmin = zmin.min(p[2]);
+                zmax = zmax.max(p[2]);
+            }
+            // across the width: within one spacing of both faces (a row of a lattice plane
+            // has a particle every √2·L0 along z)
+            let l0 = scene.discretisation.spacing;
+            assert!(
+                zmin < l0 && zmax > 0.05 - l0,
+                "{f} {name}: z {zmin}..{zmax}"
+            );
+            counts.push(g.members.len());
+        }
+        assert_eq!(
+            counts[0], counts[1],
+            "{f}: supports of {counts:?} particles"
+        );
+    }
+}
+
 /// A run loaded too fast warns, in summary.json and on stderr, with a loading time that
 /// would be quasi-static; a scene without a loading time takes the default.
 #[test]
