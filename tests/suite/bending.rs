@@ -102,8 +102,8 @@ fn beam_groups_sit_where_their_scenes_say() {
 }
 
 /// The 3D beams rest on rollers (docs/scenes.md, "Rollers"): each support and the load is
-/// one row of particles of one lattice plane, the outermost below or above (x = 25 and 150 mm below, 87.5 mm above),
-/// across the whole width, pressed by a bearing that pushes only; both supports hold as many
+/// one row of particles of one lattice plane, the outermost below or above (x = 25 and
+/// 150 mm below, 87.5 mm above), across the whole width, pressed by a bearing that pushes only; both supports hold as many
 /// particles (the lattice is symmetric about mid-span).
 #[test]
 fn beams_in_3d_rest_on_rollers_where_their_scenes_say() {
