@@ -677,3 +677,42 @@ fn tension_kernel_matches_the_full_kernel_in_3d_through_unloading() {
         }
     }
 }
+
+/// One parameter set (docs/validation.md; docs/model.md §13): every shipped 3D concrete scene
+/// sets only the concrete's own properties (strengths, fracture energy, aggregate size or a
+/// preset of them); the law's constants (crack band, softening shape, damage coupling,
+/// ultimate strain, criteria) are the defaults, calibrated once on the tension prism.
+#[test]
+fn shipped_3d_concrete_scenes_share_one_law() {
+    const OWN: [&str; 8] = [
+        "preset",
+        "fc",
+        "ft",
+        "fy",
+        "fult",
+        "Gf",
+        "Gf0",
+        "max_aggregate",
+    ];
+    let mut checked = 0;
+    for entry in std::fs::read_dir("lattices").unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        if !name.ends_with("_3d") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let value: toml::Value = toml::from_str(&text).unwrap();
+        let Some(concrete) = value.get("concrete").and_then(|c| c.as_table()) else {
+            continue;
+        };
+        for key in concrete.keys() {
+            assert!(
+                OWN.contains(&key.as_str()),
+                "{name} sets concrete.{key}: a law constant, not the concrete's own property"
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked >= 8, "{checked} 3D concrete scenes");
+}
