@@ -102,35 +102,40 @@ fn beam_groups_sit_where_their_scenes_say() {
 }
 
 /// The 3D beams rest on rollers (docs/scenes.md, "Rollers"): each support and the load is
-/// one row of particles of one lattice plane, the outermost below or above (x = 25 and
-/// 150 mm below, 87.5 mm above), across the whole width, pressed by a bearing that pushes only; both supports hold as many
-/// particles (the lattice is symmetric about mid-span).
+/// the row of particles of one lattice plane on the outermost plane below or above (x = 0.5·d
+/// and 3·d below, 1.75·d above, d the depth), across the whole width, pressed by a bearing
+/// that pushes only; both supports hold as many particles (the lattice is symmetric about
+/// mid-span).
 #[test]
 fn beams_in_3d_rest_on_rollers_where_their_scenes_say() {
-    for f in [
-        "beam_3pb_unnotched_3d",
-        "beam_3pb_notch02_3d",
-        "beam_3pb_notch05_3d",
+    for (f, d) in [
+        ("beam_3pb_unnotched_3d", 0.05),
+        ("beam_3pb_notch02_3d", 0.05),
+        ("beam_3pb_notch05_3d", 0.05),
+        ("beam_3pb_unnotched_d100_3d", 0.1),
+        ("beam_3pb_unnotched_d200_3d", 0.2),
     ] {
         let path = format!("lattices/{f}.toml");
         let scene = Scene::from_file(Path::new(&path), &[]).unwrap();
         let m = sppm::run::prepare_model(&scene, sppm::run::Fcc).unwrap();
-        // the outermost lattice plane along y lies within half a pitch (L0/√2) of its face
-        let half_pitch = 0.5 * scene.discretisation.spacing / 2f64.sqrt();
+        let x0 = &m.particles.x0;
+        let bottom = x0.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+        let top = x0.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
         let mut counts = Vec::new();
         for (name, x, y) in [
-            ("left_support", 0.025, 0.0),
-            ("right_support", 0.15, 0.0),
-            ("load", 0.0875, 0.05),
+            ("left_support", 0.5 * d, bottom),
+            ("right_support", 3.0 * d, bottom),
+            ("load", 1.75 * d, top),
         ] {
             let spec = scene.groups.iter().find(|g| g.name == name).unwrap();
             assert!(spec.bearing.is_some(), "{f} {name}: no bearing");
             let g = m.groups.iter().find(|g| g.name == name).unwrap();
+            assert!(!g.members.is_empty(), "{f} {name}: no particles");
             let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
             for &i in &g.members {
-                let p = m.particles.x0[i as usize];
+                let p = x0[i as usize];
                 assert!(
-                    (p[0] - x).abs() < 1e-6 && (p[1] - y).abs() < half_pitch,
+                    (p[0] - x).abs() < 1e-6 && (p[1] - y).abs() < 1e-6,
                     "{f} {name}: particle at {p:?}"
                 );
                 zmin = zmin.min(p[2]);

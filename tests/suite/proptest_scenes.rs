@@ -471,8 +471,8 @@ fn apply(root: &mut Value, path: &[Seg], m: &Mutation) {
     }
 }
 
-/// The shipped scenes, coarsened to about 1500 particles and shortened to 2 periods, as
-/// TOML trees (valid: they are parsed here first).
+/// The shipped scenes, coarsened to about 1500 particles (or as far as the body allows) and
+/// shortened to 2 periods, as TOML trees (valid: they are parsed here first).
 fn shipped() -> Vec<(String, Value)> {
     let mut out = vec![];
     let mut files: Vec<_> = std::fs::read_dir("lattices")
@@ -485,8 +485,10 @@ fn shipped() -> Vec<(String, Value)> {
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
         let scene = Scene::from_toml_str(&text, &[]).unwrap();
-        let spacing =
-            scene.discretisation.spacing * (estimated_particles(&scene) / 1500.0).sqrt().max(1.0);
+        // coarser, but at most the spacing a body allows (half its smallest dimension)
+        let spacing = (scene.discretisation.spacing
+            * (estimated_particles(&scene) / 1500.0).sqrt().max(1.0))
+        .min(0.4 * scene.body_size());
         let mut v: Value = Value::Table(text.parse().unwrap());
         v["discretisation"]["spacing"] = Value::Float(spacing);
         v.as_table_mut()
