@@ -294,9 +294,9 @@ fn every_shipped_scene_has_a_golden_record() {
 }
 
 /// The 3D concrete scenes run 1–6 min each on this 2-core machine (the beams of depth 100
-/// and 200 mm 7 and 48 min), beyond the suite's budget: their records are benchmarks/RESULTS.md's ("Concrete in 3D", by
-/// `benchmarks/concrete_3d.sh`), and the tension and compression prisms' physics is asserted
-/// in `tests/suite/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
+/// and 200 mm 7 and 48 min), beyond the suite's budget: their records are
+/// benchmarks/RESULTS.md's ("Concrete in 3D", by `benchmarks/concrete_3d.sh`), and the
+/// tension and compression prisms' physics is asserted in `tests/suite/concrete_3d.rs`. They have no golden record here. Nor has the notched prism of
 /// random particles (3–4 min a run): its records are RESULTS.md's ("Notched tension prism").
 /// The bond-based beams (25–45 s each) are asserted against Hobbs's (2021) peaks, and the
 /// centre-cracked slabs (3 and 10 min) against the kink of their crack, in

@@ -485,7 +485,7 @@ fn shipped() -> Vec<(String, Value)> {
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
         let scene = Scene::from_toml_str(&text, &[]).unwrap();
-        // coarser, but at most the spacing a body allows (half its smallest dimension)
+        // coarser, but below the largest spacing a body allows (half its smallest dimension)
         let spacing = (scene.discretisation.spacing
             * (estimated_particles(&scene) / 1500.0).sqrt().max(1.0))
         .min(0.4 * scene.body_size());
