@@ -350,8 +350,14 @@ impl ObjectivityReport {
             .iter()
             .map(|r| format!("{} {}×{:.2}", r.label, r.metrics[n], r.metrics[share]))
             .collect();
+        // A crack along the load axis (a split cylinder's) crosses no section normal to it.
+        let along = if none > 0 {
+            " (a crack along the load axis, as a split cylinder's, is not counted)"
+        } else {
+            ""
+        };
         Some(format!(
-            "cracks across the load axis: {one} of {} runs with one crack in the middle 60% of the length, {more} with two or more, {none} with none (run, cracks × position of the widest): {}",
+            "cracks across the load axis: {one} of {} runs with one crack in the middle 60% of the length, {more} with two or more, {none} with none{along} (run, cracks × position of the widest): {}",
             rows.len(),
             each.join(", ")
         ))
@@ -652,7 +658,7 @@ fn report(
         completed: results.iter().filter(|r| r.row.completed()).count(),
         peak_force: spread(results, |r| r.row.peak_force_n),
         dissipated_energy: spread(results, |r| r.row.dissipated_energy_j),
-        per_angle: per_angle(&args.angles_deg, &by_angle),
+        per_angle: per_angle(&args.angles_deg, &by_angle, base.dim() == 3),
         peak_force_angle_effect,
         dissipated_energy_angle_effect,
         rows: results.iter().map(|r| r.row.clone()).collect(),
@@ -662,7 +668,7 @@ fn report(
 
 /// The per-angle means over the offsets of the completed runs of each angle (`by_angle`, in
 /// the order of `angles`).
-fn per_angle(angles: &[f64], by_angle: &[Vec<&RunResult>]) -> Vec<AngleSummary> {
+fn per_angle(angles: &[f64], by_angle: &[Vec<&RunResult>], three_d: bool) -> Vec<AngleSummary> {
     let metric = |r: &RunResult, name: &str| {
         let i = CRACK_COLUMNS.iter().position(|c| *c == name).unwrap();
         r.row.metrics[i]
@@ -702,26 +708,33 @@ fn per_angle(angles: &[f64], by_angle: &[Vec<&RunResult>]) -> Vec<AngleSummary> 
                 rs.iter().map(|r| metric(r, "crack_centroid_x_m")).collect(),
             ),
             mean_crack_core_axis_deg: axis_of(rs, "crack_core_axis_deg"),
-            crack_note: crack_note_of(rs, axis_of(rs, "crack_axis_deg").is_some(), |r| {
+            crack_note: crack_note_of(rs, axis_of(rs, "crack_axis_deg").is_some(), three_d, |r| {
                 metric(r, "crack_axis_deg")
             }),
         })
         .collect()
 }
 
-/// [`AngleSummary::crack_note`] of the completed runs `rs` of an angle.
+/// [`AngleSummary::crack_note`] of the completed runs `rs` of an angle. A 3D study fits no
+/// in-plane crack axis: its cracks are counted across the load axis
+/// ([`ObjectivityReport::crack_band_line`]).
 fn crack_note_of(
     rs: &[&RunResult],
     has_mean: bool,
+    three_d: bool,
     axis: impl Fn(&RunResult) -> f64,
 ) -> Option<String> {
     let measured = rs.iter().filter(|r| axis(r).is_finite()).count();
     match (has_mean, rs.len(), measured) {
         (true, _, _) => None,
         (false, 0, _) => Some("no crack: no run completed at this angle".into()),
+        (false, n, _) if three_d => Some(format!(
+            "{n} completed 3D runs: no in-plane crack axis is fitted in 3D; the cracks across \
+             the load axis are counted below"
+        )),
         (false, n, 0) => Some(format!(
             "no crack in the {n} completed runs: fewer than 2 damaged particles away from the \
-             supports and loading points, or a 3D run"
+             supports and loading points"
         )),
         (false, _, m) => Some(format!(
             "the crack axes of the {m} runs with a crack cancel: no mean direction"
@@ -732,6 +745,7 @@ fn crack_note_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::study::runner::RunRow;
 
     #[test]
     fn offsets_lie_in_the_rotated_cell_and_depend_on_seed_and_index_only() {
@@ -755,5 +769,44 @@ mod tests {
         // the draws fill the cell: mean near 1/2
         let mean_u = (1..=2000).map(|k| offset_fraction(1, k).0).sum::<f64>() / 2000.0;
         assert!((mean_u - 0.5).abs() < 0.03, "{mean_u}");
+    }
+    fn run(axis_deg: f64) -> RunResult {
+        let mut metrics = vec![f64::NAN; CRACK_COLUMNS.len()];
+        metrics[2] = axis_deg;
+        RunResult {
+            row: RunRow {
+                label: "a0_o0".into(),
+                tags: vec![],
+                spacing_m: 0.01,
+                rotation_deg: 0.0,
+                offset_m: [0.0; 2],
+                particles: 100,
+                peak_force_n: 1.0,
+                displacement_at_peak_m: 1e-4,
+                dissipated_energy_j: 1.0,
+                wall_time_s: 1.0,
+                total_time_s: 1.0,
+                status: "completed".into(),
+                metrics,
+                message: String::new(),
+            },
+            curve: vec![],
+        }
+    }
+
+    #[test]
+    fn a_3d_angle_says_its_cracks_are_counted_across_the_load_axis_not_that_it_has_none() {
+        let (a, b) = (run(f64::NAN), run(f64::NAN));
+        let rs = [&a, &b];
+        let axis = |r: &RunResult| r.row.metrics[2];
+        let note3 = crack_note_of(&rs, false, true, axis).unwrap();
+        assert!(note3.contains("2 completed 3D runs") && note3.contains("across the load axis"));
+        let note2 = crack_note_of(&rs, false, false, axis).unwrap();
+        assert!(note2.starts_with("no crack in the 2 completed runs") && !note2.contains("3D"));
+        let c = run(90.0);
+        assert_eq!(crack_note_of(&[&c], true, false, axis), None);
+        assert!(crack_note_of(&[], false, true, axis)
+            .unwrap()
+            .contains("no run completed"));
     }
 }
