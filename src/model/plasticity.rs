@@ -14,7 +14,8 @@ pub fn effective_yield(fy: f64, fult: f64, eps_ult: f64, eps_eff: f64) -> f64 {
 }
 
 /// Plastic stretch increments (3.44)–(3.47) of a particle whose occupied slots (`used`)
-/// carry force states `fs`: ΔS_Ps = Δλ·F_dev/‖F_dev‖ with F_dev = F_s − mean(F_s) and
+/// carry the flow's values `fs` (the force states F_s, or on the FCC lattice the elastic
+/// stretches, (S.21)): ΔS_Ps = Δλ·F_dev/‖F_dev‖ with F_dev = F_s − mean(F_s) and
 /// Δλ = (f_y/E)·(ratio − 1). Adds them to `sps`; does nothing when F_dev vanishes.
 #[inline]
 pub fn flow<const K: usize>(

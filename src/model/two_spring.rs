@@ -181,10 +181,18 @@ where
                 let sigma = sigma.unwrap_or_else(criteria_stress);
                 let ratio = Dim::<D>::equivalent_stress(&sigma, law.nu, law.plane) / f_eff;
                 if ratio >= 1.0 {
+                    // The flow's direction (3.44): the deviator of the undamaged force
+                    // states, a·(S_e − mean S_e) where every bond has the modulus a. On the
+                    // FCC lattice, whose second neighbours have a + c (0.354·a at ν = 0.2),
+                    // the elastic stretches, so that the plastic stretches are a plastic
+                    // strain's (S.21).
                     let mut fs = [0.0; K];
                     for (k, f) in fs.iter_mut().enumerate() {
                         if b.used[k] {
-                            *f = force_state(b.modulus(k), b.elastic[k], b.b_theta_elastic);
+                            *f = match b.second {
+                                Some(_) => b.elastic[k],
+                                None => force_state(b.modulus(k), b.elastic[k], b.b_theta_elastic),
+                            };
                         }
                     }
                     plasticity::flow(&fs, b.used, ratio, law.fy / law.e, sps);
