@@ -102,18 +102,19 @@ fn beam_groups_sit_where_their_scenes_say() {
 }
 
 /// The 3D beams rest on rollers (docs/scenes.md, "Rollers"): each support and the load is
-/// the row of particles of one lattice plane on the outermost plane below or above (x = 0.5·d
-/// and 3·d below, 1.75·d above, d the depth), across the whole width, pressed by a bearing
-/// that pushes only; both supports hold as many particles (the lattice is symmetric about
-/// mid-span).
+/// the outermost row of particles below or above, on the lattice planes centred on x = 0.5·d
+/// and 3·d below and 1.75·d above (d the depth): one plane (3.47 mm) up to d = 100 mm, three
+/// (10.4 mm) at 200 mm, where one plane crushed. Each spans the whole width and is pressed by
+/// a bearing that pushes only; both supports hold as many particles (the lattice is
+/// symmetric about mid-span).
 #[test]
 fn beams_in_3d_rest_on_rollers_where_their_scenes_say() {
-    for (f, d) in [
-        ("beam_3pb_unnotched_3d", 0.05),
-        ("beam_3pb_notch02_3d", 0.05),
-        ("beam_3pb_notch05_3d", 0.05),
-        ("beam_3pb_unnotched_d100_3d", 0.1),
-        ("beam_3pb_unnotched_d200_3d", 0.2),
+    for (f, d, planes) in [
+        ("beam_3pb_unnotched_3d", 0.05, 1),
+        ("beam_3pb_notch02_3d", 0.05, 1),
+        ("beam_3pb_notch05_3d", 0.05, 1),
+        ("beam_3pb_unnotched_d100_3d", 0.1, 1),
+        ("beam_3pb_unnotched_d200_3d", 0.2, 3),
     ] {
         let path = format!("lattices/{f}.toml");
         let scene = Scene::from_file(Path::new(&path), &[]).unwrap();
@@ -121,6 +122,9 @@ fn beams_in_3d_rest_on_rollers_where_their_scenes_say() {
         let x0 = &m.particles.x0;
         let bottom = x0.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
         let top = x0.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
+        let l0 = scene.discretisation.spacing;
+        // the pitch of the lattice planes normal to x
+        let pitch = l0 / 2f64.sqrt();
         let mut counts = Vec::new();
         for (name, x, y) in [
             ("left_support", 0.5 * d, bottom),
@@ -132,18 +136,26 @@ fn beams_in_3d_rest_on_rollers_where_their_scenes_say() {
             let g = m.groups.iter().find(|g| g.name == name).unwrap();
             assert!(!g.members.is_empty(), "{f} {name}: no particles");
             let (mut zmin, mut zmax) = (f64::INFINITY, f64::NEG_INFINITY);
+            let mut on_plane = vec![0; planes];
             for &i in &g.members {
                 let p = x0[i as usize];
+                let k = (p[0] - x) / pitch + (planes / 2) as f64;
                 assert!(
-                    (p[0] - x).abs() < 1e-6 && (p[1] - y).abs() < 1e-6,
+                    (k - k.round()).abs() * pitch < 1e-6
+                        && (0.0..planes as f64).contains(&k.round())
+                        && (p[1] - y).abs() < 1e-6,
                     "{f} {name}: particle at {p:?}"
                 );
+                on_plane[k.round() as usize] += 1;
                 zmin = zmin.min(p[2]);
                 zmax = zmax.max(p[2]);
             }
+            assert!(
+                on_plane.iter().all(|&n| n > 0),
+                "{f} {name}: particles per plane {on_plane:?}"
+            );
             // across the width: within one spacing of both faces (a row of a lattice plane
             // has a particle every √2·L0 along z)
-            let l0 = scene.discretisation.spacing;
             assert!(
                 zmin < l0 && zmax > 0.05 - l0,
                 "{f} {name}: z {zmin}..{zmax}"
