@@ -185,7 +185,9 @@ where
                     // states, a·(S_e − mean S_e) where every bond has the modulus a. On the
                     // FCC lattice, whose second neighbours have a + c (0.354·a at ν = 0.2),
                     // the elastic stretches, so that the plastic stretches are a plastic
-                    // strain's (S.21).
+                    // strain's (S.21). Where the moduli are equal both give one direction; the
+                    // force states stay there so that those results keep their golden records
+                    // bit for bit (the rounding differs).
                     let mut fs = [0.0; K];
                     for (k, f) in fs.iter_mut().enumerate() {
                         if b.used[k] {
