@@ -2,7 +2,7 @@
 //! tensile initiation and bilinear softening (§8, (4.12)–(4.14)), compressive damage
 //! (§9, (4.16), (4.17)).
 
-use crate::scene::{CrackOpening, Initiation, Plane, Scene};
+use crate::scene::{CrackOpening, Initiation, Plane, Scene, SofteningStress};
 
 /// The resolved concrete law of a run (every value in SI; see `Scene::concrete_law`).
 #[derive(Clone, Copy, Debug, serde::Serialize)]
@@ -25,6 +25,7 @@ pub struct ConcreteLaw {
     pub wc_max: f64,
     pub initiation: Initiation,
     pub crack_opening: CrackOpening,
+    pub softening_stress: SofteningStress,
     pub tensile_damage: bool,
     pub compressive_damage: bool,
     pub plasticity: bool,
@@ -72,6 +73,7 @@ impl ConcreteLaw {
             wc_max: 1.0,
             initiation: Initiation::Rankine,
             crack_opening: CrackOpening::Total,
+            softening_stress: SofteningStress::Strain,
             tensile_damage: true,
             compressive_damage: full,
             plasticity: full,
@@ -101,6 +103,7 @@ impl ConcreteLaw {
             wc_max: c.wc_max,
             initiation: c.initiation,
             crack_opening: c.crack_opening,
+            softening_stress: c.softening_stress,
             tensile_damage: c.tensile_damage,
             compressive_damage: c.compressive_damage,
             plasticity: c.plasticity,
@@ -181,12 +184,20 @@ pub fn initiates(law: &ConcreteLaw, p1: f64, p3: f64) -> bool {
 }
 
 /// Tensile damage (4.14) of an initiated particle with largest principal strain ε_I, so that
-/// (1−w_t)·E·ε_I follows the softening law at COD_eq = band·ε_I (4.13), or, with
+/// (1−w_t)·σ_ref follows the softening law at COD_eq = band·ε_I (4.13), or, with
 /// [`CrackOpening::Inelastic`], at band·(ε_I − ε_I,0) with ε_I,0 the strain at initiation;
-/// `band` is the particle's crack band in m (`crack_band`·L0,i). Returns 0 where ε_I ≤ 0
-/// (the caller keeps the larger of old and new).
+/// `band` is the particle's crack band in m (`crack_band`·L0,i). σ_ref = `stress` is what
+/// [`SofteningStress`] chooses ([`softened_stress`]): E·ε_I as (4.14) writes, or the effective
+/// principal stress σ̃_I (S.22). Returns 0 where ε_I ≤ 0 or σ_ref ≤ 0 short of COD_c (the
+/// caller keeps the larger of old and new).
 #[inline]
-pub fn tensile_damage(law: &ConcreteLaw, band: f64, eps_i: f64, eps_at_initiation: f64) -> f64 {
+pub fn tensile_damage(
+    law: &ConcreteLaw,
+    band: f64,
+    eps_i: f64,
+    eps_at_initiation: f64,
+    stress: f64,
+) -> f64 {
     if eps_i <= 0.0 {
         return 0.0;
     }
@@ -197,8 +208,22 @@ pub fn tensile_damage(law: &ConcreteLaw, band: f64, eps_i: f64, eps_at_initiatio
     if cod >= law.cod_c {
         return 1.0;
     }
-    let w = 1.0 - softening_stress(law, cod) / (law.e * eps_i);
+    if stress <= 0.0 {
+        return 0.0;
+    }
+    let w = 1.0 - softening_stress(law, cod) / stress;
     w.clamp(0.0, 1.0)
+}
+
+/// The stress (4.14) softens (docs/model.md §8): E·ε_I ([`SofteningStress::Strain`]) or σ̃_I,
+/// the largest principal stress of the undamaged elastic strain, given as `sigma_i`, which
+/// is only called for where it is needed ([`SofteningStress::Stress`], (S.22)).
+#[inline]
+pub fn softened_stress(law: &ConcreteLaw, eps_i: f64, sigma_i: impl FnOnce() -> f64) -> f64 {
+    match law.softening_stress {
+        SofteningStress::Strain => law.e * eps_i,
+        SofteningStress::Stress => sigma_i(),
+    }
 }
 
 /// Compressive damage (4.16) from the tensile damage, and 1 once ε_eff > ε_ult (4.17).
@@ -245,6 +270,7 @@ mod tests {
             wc_max: 1.0,
             initiation: Initiation::Rankine,
             crack_opening: opening,
+            softening_stress: SofteningStress::Strain,
             tensile_damage: true,
             compressive_damage: true,
             plasticity: true,
@@ -283,7 +309,7 @@ mod tests {
             let e0 = l.ft / l.e;
             for f in [1.0, 1.5, 3.0, 10.0, 30.0] {
                 let eps = f * e0;
-                let w = tensile_damage(&l, l.crack_band, eps, e0);
+                let w = tensile_damage(&l, l.crack_band, eps, e0, l.e * eps);
                 let cod = match opening {
                     CrackOpening::Total => l.crack_band * eps,
                     CrackOpening::Inelastic => l.crack_band * (eps - e0),
@@ -293,7 +319,13 @@ mod tests {
             }
             // beyond COD_c the particle is fully damaged
             assert_eq!(
-                tensile_damage(&l, l.crack_band, 2.0 * l.cod_c / l.crack_band + e0, e0),
+                tensile_damage(
+                    &l,
+                    l.crack_band,
+                    2.0 * l.cod_c / l.crack_band + e0,
+                    e0,
+                    l.ft
+                ),
                 1.0
             );
         }
@@ -301,10 +333,38 @@ mod tests {
         let l = law(CrackOpening::Total);
         let e0 = l.ft / l.e;
         let jump = (1.0 - l.gamma) * l.crack_band * e0 / l.cod_1;
-        assert!((tensile_damage(&l, l.crack_band, e0, e0) - jump).abs() < 1e-12);
+        assert!((tensile_damage(&l, l.crack_band, e0, e0, l.ft) - jump).abs() < 1e-12);
         assert_eq!(
-            tensile_damage(&law(CrackOpening::Inelastic), 0.01, e0, e0),
+            tensile_damage(&law(CrackOpening::Inelastic), 0.01, e0, e0, l.ft),
             0.0
+        );
+    }
+
+    /// (S.22) at the split cylinder's initiation, σ_x = f't across the crack and σ_y = −3·f't
+    /// along it (plane stress): E·ε_I = 1.6·f't, so (4.14) as written puts the particle past
+    /// w_t,cr at once, with compressive damage to follow, at a tension test's opening; softening
+    /// σ̃_I = f't leaves (1 − w_t)·σ̃_I on the law, w_t near the uniaxial jump.
+    #[test]
+    fn the_effective_stress_softens_on_the_law_under_lateral_compression() {
+        let mut l = law(CrackOpening::Total);
+        let (sx, sy) = (l.ft, -3.0 * l.ft);
+        let eps = (sx - l.nu * sy) / l.e;
+        let on_law = softening_stress(&l, l.crack_band * eps);
+        let w = |l: &ConcreteLaw| {
+            tensile_damage(l, l.crack_band, eps, eps, softened_stress(l, eps, || sx))
+        };
+        let as_written = w(&l);
+        assert!(((1.0 - as_written) * l.e * eps - on_law).abs() < 1e-6 * l.ft);
+        assert!(as_written > l.wt_cr, "{as_written}");
+        l.softening_stress = SofteningStress::Stress;
+        let effective = w(&l);
+        assert!(((1.0 - effective) * sx - on_law).abs() < 1e-6 * l.ft);
+        assert!(effective < 0.1, "{effective}");
+        // where compression leaves no tension to soften, only COD_c damages
+        assert_eq!(tensile_damage(&l, l.crack_band, eps, eps, -1.0), 0.0);
+        assert_eq!(
+            tensile_damage(&l, l.crack_band, l.cod_c / l.crack_band, 0.0, -1.0),
+            1.0
         );
     }
 

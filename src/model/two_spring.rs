@@ -163,7 +163,15 @@ where
                 p.eps_init = e1;
             }
             let band = law.crack_band * b.length();
-            p.wt = p.wt.max(damage::tensile_damage(law, band, e1, p.eps_init));
+            // (S.22): σ̃_I of the undamaged elastic strain, D·ε_e, with the particle's own E.
+            let sigma_i = || {
+                let eps_e = Dim::<D>::strain_tensor(b.fit, b.elastic);
+                let s = Dim::<D>::stress_of_strain(&(self.d * (law.e / self.law.e)), &eps_e);
+                Dim::<D>::principal_stress_extremes(&s, law.nu, law.plane).0
+            };
+            let stress = damage::softened_stress(law, e1, sigma_i);
+            p.wt =
+                p.wt.max(damage::tensile_damage(law, band, e1, p.eps_init, stress));
         }
         if FULL {
             let eps_eff = match principal {
