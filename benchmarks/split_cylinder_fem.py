@@ -138,13 +138,16 @@ def solve(args):
     return nodes, hexes, zs, u, p, c, b
 
 
-def strain_at(nodes, hexes, u, b, point):
-    """Strain at the element centroid nearest to `point` (mean of its Gauss points)."""
+def nearest_element(nodes, hexes, point):
+    """The element whose centroid is nearest to `point`."""
     cent = nodes[hexes].mean(axis=1)
-    e = np.argmin(np.linalg.norm(cent - point, axis=1))
+    return int(np.argmin(np.linalg.norm(cent - point, axis=1)))
+
+
+def strain_of(nodes, hexes, u, b, e):
+    """Strain of element `e` (mean of its Gauss points) and its centroid."""
     ue = u[(3 * hexes[e][:, None] + np.arange(3)).ravel()]
-    eps = np.einsum("qij,j->qi", b[e], ue).mean(axis=0)
-    return eps, cent[e]
+    return np.einsum("qij,j->qi", b[e], ue).mean(axis=0), nodes[hexes[e]].mean(axis=0)
 
 
 def main():
@@ -167,8 +170,10 @@ def main():
         y0 = yfrac * args.diameter
         print(f"loaded diameter x = 0, y = {y0 * 1e3:.1f} mm:")
         print(" z (mm)   e_xx/P (ustrain/MN)   s_xx/sigma0   s_zz/sigma0")
-        for zq in list(zc[:8]) + [0.02, 0.03, 0.05, 0.075, 0.1, 0.15]:
-            eps, cen = strain_at(nodes, hexes, u, b, np.array([0.0, y0, zq]))
+        depths = list(zc[:8]) + [0.02, 0.03, 0.05, 0.075, 0.1, 0.15]
+        elements = [nearest_element(nodes, hexes, np.array([0.0, y0, zq])) for zq in depths]
+        for e in dict.fromkeys(elements):  # each element once, in order of depth
+            eps, cen = strain_of(nodes, hexes, u, b, e)
             sig = c @ eps
             print(f" {cen[2] * 1e3:6.2f}   {eps[0] / p * 1e12:8.1f}"
                   f"            {sig[0] / sigma0:6.3f}        {sig[2] / sigma0:6.3f}")

@@ -13,7 +13,7 @@
 
 use super::damage::{self, ConcreteLaw, LocalProperties};
 use super::damage_law::{DamageLaw, Kernel, ParticleBonds, ParticleDamage};
-use super::dimension::{Dim, Dimension};
+use super::dimension::{Dim, Dimension, Tensor};
 use super::force_state::force_state;
 use super::plasticity;
 
@@ -119,6 +119,9 @@ where
         // Strains (§7): total for the damage law and ε_eff; the criteria stress from the
         // damaged elastic stretches.
         let eps = Dim::<D>::strain_tensor(b.fit, b.total);
+        // D·ε with the particle's own E (D is linear in E: it scales the law's D).
+        let stress_of =
+            |e: &Tensor<D>| Dim::<D>::stress_of_strain(&(self.d * (law.e / self.law.e)), e);
         // The criteria stress D·ε_d, needed only to test initiation and yield.
         let criteria_stress = || {
             let eps_d = match b.criteria_strain {
@@ -126,8 +129,7 @@ where
                 None if b.undamaged => eps,
                 None => Dim::<D>::strain_tensor(b.fit, b.damaged),
             };
-            // D is linear in E: a particle's own E scales the law's D.
-            Dim::<D>::stress_of_strain(&(self.d * (law.e / self.law.e)), &eps_d)
+            stress_of(&eps_d)
         };
 
         // Tensile damage (§8). The initiation test is monotone in (σ_max, −σ_min), so bounds
@@ -163,11 +165,15 @@ where
                 p.eps_init = e1;
             }
             let band = law.crack_band * b.length();
-            // (S.22): σ̃_I of the undamaged elastic strain, D·ε_e, with the particle's own E.
+            // (S.22): σ̃_I of the undamaged elastic strain, D·ε_e (ε itself where nothing
+            // has yielded or been damaged).
             let sigma_i = || {
-                let eps_e = Dim::<D>::strain_tensor(b.fit, b.elastic);
-                let s = Dim::<D>::stress_of_strain(&(self.d * (law.e / self.law.e)), &eps_e);
-                Dim::<D>::principal_stress_extremes(&s, law.nu, law.plane).0
+                let eps_e = if b.undamaged {
+                    eps
+                } else {
+                    Dim::<D>::strain_tensor(b.fit, b.elastic)
+                };
+                Dim::<D>::principal_stress_extremes(&stress_of(&eps_e), law.nu, law.plane).0
             };
             let stress = damage::softened_stress(law, e1, sigma_i);
             p.wt =
