@@ -73,7 +73,7 @@ impl ConcreteLaw {
             wc_max: 1.0,
             initiation: Initiation::Rankine,
             crack_opening: CrackOpening::Total,
-            softening_stress: SofteningStress::Strain,
+            softening_stress: SofteningStress::default(),
             tensile_damage: true,
             compressive_damage: full,
             plasticity: full,

@@ -84,6 +84,9 @@ pub struct Summary {
     /// the peak and after it while the force stays at 80% of the peak or more), over the records where the internal energy is
     /// at least 1% of its maximum (the quasi-static check).
     pub max_kinetic_to_internal_energy: f64,
+    /// The same over the records up to the peak: what the loading pace and any added mass
+    /// can change. After the peak a crack that runs unstably is kinetic at any pace.
+    pub max_kinetic_to_internal_energy_to_peak: f64,
     /// The same over the whole run (after complete failure the elastic energy vanishes and
     /// this ratio says little).
     pub max_kinetic_to_internal_energy_whole_run: f64,
@@ -182,16 +185,18 @@ pub struct BondReport {
 pub const QUASI_STATIC_LIMIT: f64 = 0.01;
 
 /// What the run did that may have changed its result: the scene's inputs outside their
-/// usual range, a load too fast ([`loading_warning`]), added mass with a kinetic energy
-/// above the quasi-static limit.
+/// usual range, a load too fast ([`loading_warning`], on `ratio` around the peak), added
+/// mass with a kinetic energy above the quasi-static limit up to the peak (`to_peak`: a
+/// crack that runs unstably after the peak is kinetic with or without the added mass).
 fn run_warnings<const K: usize, const D: usize>(
     p: &Prepared<K, D>,
     method: SolverMethod,
     ratio: f64,
+    to_peak: f64,
 ) -> Vec<String> {
-    let mass = p.mass_scaling.filter(|_| ratio > QUASI_STATIC_LIMIT).map(|m| {
+    let mass = p.mass_scaling.filter(|_| to_peak > QUASI_STATIC_LIMIT).map(|m| {
         format!(
-            "solver.mass_scaling added {:.2}% of the mass and the kinetic energy reached {ratio:.3e} × the elastic energy around the peak, above the quasi-static {QUASI_STATIC_LIMIT}: the added mass may have changed the result; lower solver.mass_scaling or leave it out",
+            "solver.mass_scaling added {:.2}% of the mass and the kinetic energy reached {to_peak:.3e} × the elastic energy up to the peak, above the quasi-static {QUASI_STATIC_LIMIT}: the added mass may have changed the result; lower solver.mass_scaling or leave it out",
             100.0 * m.added_mass_fraction
         )
     });
@@ -425,18 +430,17 @@ pub(super) fn summarise<const K: usize, const D: usize>(
     };
     // Before and around the peak: the records up to the peak and after it while the force
     // stays at 80% of the peak or more.
-    let window_end = match peak {
-        Some(pk) => {
-            let ipk = records.iter().position(|r| r.step == pk.step).unwrap_or(0);
-            records[ipk..]
-                .iter()
-                .position(|r| sign * r.force_n < 0.8 * sign * pk.force_n)
-                .map(|o| ipk + o)
-                .unwrap_or(records.len())
-        }
-        None => records.len(),
+    let ipk = peak.map(|pk| records.iter().position(|r| r.step == pk.step).unwrap_or(0));
+    let window_end = match (peak, ipk) {
+        (Some(pk), Some(ipk)) => records[ipk..]
+            .iter()
+            .position(|r| sign * r.force_n < 0.8 * sign * pk.force_n)
+            .map(|o| ipk + o)
+            .unwrap_or(records.len()),
+        _ => records.len(),
     };
     let ratio = ratio_over(&records[..window_end]);
+    let ratio_to_peak = ratio_over(&records[..ipk.map_or(records.len(), |i| i + 1)]);
     let ratio_whole = ratio_over(records);
     let d = &p.model.scene.discretisation;
     Summary {
@@ -485,6 +489,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         internal_energy_j: last.internal_j,
         kinetic_energy_j: last.kinetic_j,
         max_kinetic_to_internal_energy: ratio,
+        max_kinetic_to_internal_energy_to_peak: ratio_to_peak,
         max_kinetic_to_internal_energy_whole_run: ratio_whole,
         max_damage: damage.map(|d| d.iter().map(|p| p.wt).fold(0.0, f64::max)),
         max_compressive_damage: damage.map(|d| d.iter().map(|p| p.wc).fold(0.0, f64::max)),
@@ -514,7 +519,7 @@ pub(super) fn summarise<const K: usize, const D: usize>(
         bond_damping_ratio_at_omega_max: p.stable.zeta,
         bond_damper_implicit_share: p.stable.implicit_share,
         mass_scaling: p.mass_scaling,
-        warnings: run_warnings(p, method, ratio),
+        warnings: run_warnings(p, method, ratio, ratio_to_peak),
         pace: p.model.scene.pace(),
         seed: p.model.scene.effective_seed(),
         random_fields: p.model.fields.iter().map(|f| f.report.clone()).collect(),

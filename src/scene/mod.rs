@@ -237,10 +237,11 @@ pub enum CrackOpening {
 }
 
 /// What the tensile damage (4.14) makes follow the softening law (docs/model.md §8, (S.22)).
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum SofteningStress {
-    /// (1 − w_t)·E·ε_I, as (4.14) writes it.
+    /// The default: (1 − w_t)·E·ε_I, as (4.14) writes it.
+    #[default]
     Strain,
     /// (1 − w_t)·σ̃_I, σ̃_I the largest principal stress of the particle's undamaged elastic
     /// strain (the effective stress): equal to E·ε_I in uniaxial tension, below it where the
@@ -320,7 +321,7 @@ pub struct ConcreteSpec {
     #[serde(default = "default_crack_opening")]
     pub crack_opening: CrackOpening,
     /// What (4.14) softens (docs/model.md §8, (S.22)); default `strain`, as the source writes.
-    #[serde(default = "default_softening_stress")]
+    #[serde(default)]
     pub softening_stress: SofteningStress,
     /// The strain initiation and yield read (docs/model.md §7): default the neighbourhood mean
     /// (S.16) on random particles, each particle's own strain on the lattices. Always set
@@ -358,9 +359,6 @@ fn default_initiation() -> Initiation {
 }
 fn default_crack_opening() -> CrackOpening {
     CrackOpening::Total
-}
-fn default_softening_stress() -> SofteningStress {
-    SofteningStress::Strain
 }
 
 /// A named set of particles, with its supports and displacement loading.

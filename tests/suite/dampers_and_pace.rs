@@ -126,7 +126,7 @@ fn mass_scaling_raises_the_step_and_reports_what_it_added() {
         let s = run(&Scene::from_file(file, &o).unwrap(), &quiet())
             .unwrap()
             .summary;
-        (s.max_kinetic_to_internal_energy, s.warnings)
+        (s.max_kinetic_to_internal_energy_to_peak, s.warnings)
     };
     let (ratio, w) = warnings("2");
     assert!(

@@ -80,8 +80,13 @@ fn compression_forces_are_reported_positive_and_say_so() {
     let s = &o.summary;
     assert!(s.sign_turned);
     assert!(s.peak_force_n > 0.0, "{}", s.peak_force_n);
-    // after crushing the block still carries some load the same way
-    assert!(s.final_force_n >= 0.0, "{}", s.final_force_n);
+    // the block is broken through by the end of the stroke: what it still carries is zero
+    // to round-off, never a force of the other sign
+    assert!(
+        s.final_force_n >= -1e-9 * s.peak_force_n,
+        "{}",
+        s.final_force_n
+    );
     assert!(s.final_force_n <= s.peak_force_n);
     let svg = std::fs::read_to_string(dir.join("force_displacement.svg")).unwrap();
     assert!(svg.contains("(sign turned)"));
