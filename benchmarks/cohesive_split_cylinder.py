@@ -74,11 +74,8 @@ class Disc:
     """The quarter disc's mesh, stiffness, crack springs and strip."""
 
     def __init__(self, n, strip, e):
-        self.n = n
         node = lambda i, j: j * (n + 1) + i
-        self.node = node
         pts = np.array([mapped(i / n, j / n) for j in range(n + 1) for i in range(n + 1)])
-        self.pts = pts
         nn = len(pts)
         rows, cols, vals = [], [], []
         self.centre_stress = None
@@ -99,7 +96,7 @@ class Disc:
         ys = pts[[node(0, j) for j in range(n + 1)], 1]
         lo = np.concatenate([[0.0], (ys[:-1] + ys[1:]) / 2])
         hi = np.concatenate([(ys[:-1] + ys[1:]) / 2, [R]])
-        self.area = (hi - lo) * H
+        area = (hi - lo) * H
         self.crack = np.array([2 * node(0, j) for j in range(n + 1)])
         # the strip: the arc's nodes (edge v = 1) with x <= b/2
         top = [node(i, n) for i in range(n + 1) if pts[node(i, n), 0] <= strip / 2 + 1e-12]
@@ -109,7 +106,8 @@ class Disc:
         self.fixed = np.unique(np.concatenate([self.strip_y, strip_x, sym_y]))
         self.free = np.setdiff1d(np.arange(2 * nn), self.fixed)
         # the crack node under the strip is held in x with the strip: not a spring
-        self.springs = np.setdiff1d(self.crack, strip_x)
+        spring = ~np.isin(self.crack, strip_x)
+        self.springs, self.spring_area = self.crack[spring], area[spring]
 
 
 def p56(ft, strip):
@@ -137,8 +135,7 @@ def solve(disc, law, steps, opening):
     """Load against strip displacement, the centre's crack opening w_c pushed up in `steps`
     equal steps to `opening` (indirect control: the strip's displacement is the unknown that
     keeps the centre node in equilibrium, so the load may fall as the crack runs)."""
-    k, dof = disc.k, disc.springs
-    area = disc.area[[list(disc.crack).index(d) for d in dof]]
+    k, dof, area = disc.k, disc.springs, disc.spring_area
     centre = disc.crack[0]
     unknown = np.setdiff1d(disc.free, [centre])  # the displacements solved for, and delta
     rows = disc.free  # the equilibrium equations: every free node, the centre's included

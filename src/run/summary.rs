@@ -430,17 +430,18 @@ pub(super) fn summarise<const K: usize, const D: usize>(
     };
     // Before and around the peak: the records up to the peak and after it while the force
     // stays at 80% of the peak or more.
-    let ipk = peak.map(|pk| records.iter().position(|r| r.step == pk.step).unwrap_or(0));
-    let window_end = match (peak, ipk) {
-        (Some(pk), Some(ipk)) => records[ipk..]
-            .iter()
-            .position(|r| sign * r.force_n < 0.8 * sign * pk.force_n)
-            .map(|o| ipk + o)
-            .unwrap_or(records.len()),
-        _ => records.len(),
+    let (to_peak_end, window_end) = match peak {
+        Some(pk) => {
+            let ipk = records.iter().position(|r| r.step == pk.step).unwrap_or(0);
+            let drop = records[ipk..]
+                .iter()
+                .position(|r| sign * r.force_n < 0.8 * sign * pk.force_n);
+            (ipk + 1, drop.map_or(records.len(), |o| ipk + o))
+        }
+        None => (records.len(), records.len()),
     };
     let ratio = ratio_over(&records[..window_end]);
-    let ratio_to_peak = ratio_over(&records[..ipk.map_or(records.len(), |i| i + 1)]);
+    let ratio_to_peak = ratio_over(&records[..to_peak_end]);
     let ratio_whole = ratio_over(records);
     let d = &p.model.scene.discretisation;
     Summary {
