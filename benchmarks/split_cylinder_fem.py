@@ -97,18 +97,23 @@ def elasticity(e, nu):
     return c
 
 
-def solve(args):
-    r, half_len = args.diameter / 2, args.length / 2
-    nodes, hexes, zs = mesh(args.n, args.nz, r, half_len, args.grade)
-    dn = shape_derivs()
-    b, det = b_matrices(nodes, hexes, dn)
-    c = elasticity(args.e, args.nu)
+def stiffness(nodes, hexes, e, nu):
+    """The global stiffness (sparse), the elasticity matrix and the elements' B matrices."""
+    b, det = b_matrices(nodes, hexes, shape_derivs())
+    c = elasticity(e, nu)
     ke = np.einsum("eqki,kl,eqlj,eq->eij", b, c, b, det)
     dofs = (3 * hexes[:, :, None] + np.arange(3)[None, None, :]).reshape(len(hexes), 24)
     rows = np.repeat(dofs, 24, axis=1).ravel()
     cols = np.tile(dofs, (1, 24)).ravel()
     ndof = 3 * len(nodes)
-    k = sp.csr_matrix((ke.ravel(), (rows, cols)), shape=(ndof, ndof))
+    return sp.csr_matrix((ke.ravel(), (rows, cols)), shape=(ndof, ndof)), c, b
+
+
+def solve(args):
+    r, half_len = args.diameter / 2, args.length / 2
+    nodes, hexes, zs = mesh(args.n, args.nz, r, half_len, args.grade)
+    k, c, b = stiffness(nodes, hexes, args.e, args.nu)
+    ndof = 3 * len(nodes)
 
     x, y, z = nodes.T
     tol = 1e-9

@@ -185,7 +185,8 @@ pub fn initiates(law: &ConcreteLaw, p1: f64, p3: f64) -> bool {
 
 /// Tensile damage (4.14) of an initiated particle with largest principal strain ε_I, so that
 /// (1−w_t)·σ_ref follows the softening law at COD_eq = band·ε_I (4.13), or, with
-/// [`CrackOpening::Inelastic`], at band·(ε_I − ε_I,0) with ε_I,0 the strain at initiation;
+/// [`CrackOpening::Inelastic`], at band·(ε_I − ε_I,0) with ε_I,0 the strain at initiation
+/// (S.14), or, with [`CrackOpening::Stress`], at band·σ_ref/E (S.23);
 /// `band` is the particle's crack band in m (`crack_band`·L0,i). σ_ref = `stress` is what
 /// [`SofteningStress`] chooses ([`softened_stress`]): E·ε_I as (4.14) writes, or the effective
 /// principal stress σ̃_I (S.22). Returns 0 where ε_I ≤ 0 or σ_ref ≤ 0 short of COD_c (the
@@ -204,6 +205,7 @@ pub fn tensile_damage(
     let cod = match law.crack_opening {
         CrackOpening::Total => band * eps_i,
         CrackOpening::Inelastic => band * (eps_i - eps_at_initiation),
+        CrackOpening::Stress => band * stress.max(0.0) / law.e,
     };
     if cod >= law.cod_c {
         return 1.0;
@@ -304,30 +306,27 @@ mod tests {
 
     #[test]
     fn tensile_damage_follows_the_softening_curve() {
-        for opening in [CrackOpening::Total, CrackOpening::Inelastic] {
+        for opening in [
+            CrackOpening::Total,
+            CrackOpening::Inelastic,
+            CrackOpening::Stress,
+        ] {
             let l = law(opening);
             let e0 = l.ft / l.e;
             for f in [1.0, 1.5, 3.0, 10.0, 30.0] {
                 let eps = f * e0;
                 let w = tensile_damage(&l, l.crack_band, eps, e0, l.e * eps);
                 let cod = match opening {
-                    CrackOpening::Total => l.crack_band * eps,
+                    // with E·ε_I softened, (S.23) reads the opening of ε_I
+                    CrackOpening::Total | CrackOpening::Stress => l.crack_band * eps,
                     CrackOpening::Inelastic => l.crack_band * (eps - e0),
                 };
                 let sigma = (1.0 - w) * l.e * eps;
                 assert!((sigma - softening_stress(&l, cod)).abs() < 1e-6 * l.ft);
             }
             // beyond COD_c the particle is fully damaged
-            assert_eq!(
-                tensile_damage(
-                    &l,
-                    l.crack_band,
-                    2.0 * l.cod_c / l.crack_band + e0,
-                    e0,
-                    l.ft
-                ),
-                1.0
-            );
+            let eps = 2.0 * l.cod_c / l.crack_band + e0;
+            assert_eq!(tensile_damage(&l, l.crack_band, eps, e0, l.e * eps), 1.0);
         }
         // As written, w_t jumps at initiation by (1−γ)·COD_el/COD_1 (the source says so).
         let l = law(CrackOpening::Total);
@@ -366,6 +365,27 @@ mod tests {
             tensile_damage(&l, l.crack_band, l.cod_c / l.crack_band, 0.0, -1.0),
             1.0
         );
+    }
+
+    /// (S.23) at the same initiation: the opening read from σ̃_I/E is the uniaxial one, so w_t
+    /// is the uniaxial jump (1 − γ)·COD_el/COD_1 exactly, where ε_I's opening is 1.6 × it;
+    /// with E·ε_I softened, as written, (S.23) is the opening as written.
+    #[test]
+    fn the_opening_of_the_effective_stress_is_the_uniaxial_one() {
+        let mut l = law(CrackOpening::Stress);
+        let (sx, sy) = (l.ft, -3.0 * l.ft);
+        let eps = (sx - l.nu * sy) / l.e;
+        let w = |l: &ConcreteLaw| {
+            tensile_damage(l, l.crack_band, eps, eps, softened_stress(l, eps, || sx))
+        };
+        let total = law(CrackOpening::Total);
+        assert!((w(&l) - w(&total)).abs() < 1e-15);
+        l.softening_stress = SofteningStress::Stress;
+        let jump = (1.0 - l.gamma) * l.crack_band * (l.ft / l.e) / l.cod_1;
+        assert!((w(&l) - jump).abs() < 1e-12, "{} against {jump}", w(&l));
+        // (S.22) alone reads the opening of ε_I = 1.6·f't/E: a larger jump
+        l.crack_opening = CrackOpening::Total;
+        assert!(w(&l) > 1.5 * jump, "{} against {jump}", w(&l));
     }
 
     #[test]

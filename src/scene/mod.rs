@@ -234,6 +234,10 @@ pub enum CrackOpening {
     Total,
     /// COD_eq measured from initiation: 2·L0·(ε_I − ε_I at initiation).
     Inelastic,
+    /// COD_eq from the stress (4.14) softens, over E: crack_band·L0·σ_ref/E (S.23). With
+    /// `softening_stress = "stress"` that is σ̃_I/E, the strain the particle would have in
+    /// uniaxial tension at its principal stress; with `"strain"` it is ε_I, as written.
+    Stress,
 }
 
 /// What the tensile damage (4.14) makes follow the softening law (docs/model.md §8, (S.22)).
