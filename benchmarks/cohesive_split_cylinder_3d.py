@@ -64,14 +64,14 @@ class Cylinder:
         self.area = self._lumped_areas(nodes, hexes, spring_nodes)
         self.yz = nodes[spring_nodes][:, 1:]
         inner = np.setdiff1d(np.arange(3 * len(nodes)), np.concatenate([list(held), self.strip_y, self.springs]))
-        # columns: the springs' u_x, then delta (the strip's y-DOFs move by -delta)
-        kc = k[:, self.springs].toarray()
-        kd = -np.asarray(k[:, self.strip_y].sum(axis=1)).ravel()
-        cols = np.column_stack([kc, kd])
-        lu = spla.splu(k[inner][:, inner].tocsc())
-        x_inner = lu.solve(-cols[inner])
-        full = np.zeros((3 * len(nodes), cols.shape[1]))
-        full[inner] = x_inner
+        # unit modes: each spring's u_x, then delta (the strip's y-DOFs move by -delta); the
+        # inner DOFs follow in equilibrium. Only the inner rows of k are made dense.
+        k_inner = k[inner]
+        rhs = np.column_stack([k_inner[:, self.springs].toarray(),
+                               -np.asarray(k_inner[:, self.strip_y].sum(axis=1)).ravel()])
+        lu = spla.splu(k_inner[:, inner].tocsc())
+        full = np.zeros((3 * len(nodes), rhs.shape[1]))
+        full[inner] = lu.solve(-rhs)
         full[self.springs, np.arange(len(self.springs))] = 1.0
         full[self.strip_y, -1] = -1.0
         # the generalised forces each unit mode needs: at each spring its x-force; for delta,
