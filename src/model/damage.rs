@@ -73,7 +73,7 @@ impl ConcreteLaw {
             wc_max: 1.0,
             initiation: Initiation::Rankine,
             crack_opening: CrackOpening::Total,
-            softening_stress: SofteningStress::default(),
+            softening_stress: SofteningStress::Strain,
             tensile_damage: true,
             compressive_damage: full,
             plasticity: full,
@@ -86,6 +86,7 @@ impl ConcreteLaw {
         let c = scene.concrete.as_ref()?;
         let get = |k: &str| scene.derived_value(k).unwrap_or(f64::NAN);
         let cod_c = get("COD_c");
+        let reading = scene.law_reading()?;
         Some(ConcreteLaw {
             e: scene.material.youngs_modulus(),
             nu: scene.material.nu,
@@ -102,8 +103,8 @@ impl ConcreteLaw {
             wt_cr: c.wt_cr,
             wc_max: c.wc_max,
             initiation: c.initiation,
-            crack_opening: c.crack_opening,
-            softening_stress: c.softening_stress,
+            crack_opening: reading.1,
+            softening_stress: reading.0,
             tensile_damage: c.tensile_damage,
             compressive_damage: c.compressive_damage,
             plasticity: c.plasticity,

@@ -241,15 +241,14 @@ pub enum CrackOpening {
 }
 
 /// What the tensile damage (4.14) makes follow the softening law (docs/model.md §8, (S.22)).
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum SofteningStress {
-    /// The default: (1 − w_t)·E·ε_I, as (4.14) writes it.
-    #[default]
+    /// (1 − w_t)·E·ε_I, as (4.14) writes it (the 2D default).
     Strain,
     /// (1 − w_t)·σ̃_I, σ̃_I the largest principal stress of the particle's undamaged elastic
     /// strain (the effective stress): equal to E·ε_I in uniaxial tension, below it where the
-    /// particle is compressed across the crack.
+    /// particle is compressed across the crack (the 3D default).
     Stress,
 }
 
@@ -314,19 +313,22 @@ pub struct ConcreteSpec {
     /// COD_eq = crack_band·L0·ε_I. (4.13) writes 2; the defaults are measured. Lattices 2.8:
     /// with 2, a block in uniaxial tension dissipates 1.32 and 1.47 × G_f·A at L0 = 10 and
     /// 5 mm; with 2.8, 0.975 and 1.029 × G_f·A (benchmarks/RESULTS.md, "Concrete in 2D").
-    /// Random particles 3.2 (docs/sppm.md, "Crack band"); the FCC lattice 3.3
-    /// (benchmarks/RESULTS.md, "Concrete in 3D"); random particles in 3D
+    /// Random particles 3.2 (docs/sppm.md, "Crack band"); the FCC lattice 3.45
+    /// (benchmarks/RESULTS.md, "The effective stress as the 3D default"); random particles in 3D
     /// (`scene::resolve::RANDOM_3D_CRACK_BAND`; benchmarks/RESULTS.md, "Random particles in 3D").
     /// Always set after [`Scene::resolve`].
     #[serde(default)]
     pub crack_band: Option<f64>,
     #[serde(default = "default_initiation")]
     pub initiation: Initiation,
-    #[serde(default = "default_crack_opening")]
-    pub crack_opening: CrackOpening,
-    /// What (4.14) softens (docs/model.md §8, (S.22)); default `strain`, as the source writes.
+    /// The opening (4.14) reads (docs/model.md §8): default `stress` (S.23) in 3D, `total`
+    /// (4.13) in 2D. Always set after [`Scene::resolve`].
     #[serde(default)]
-    pub softening_stress: SofteningStress,
+    pub crack_opening: Option<CrackOpening>,
+    /// What (4.14) softens (docs/model.md §8, (S.22)): default `stress` in 3D, `strain` (as
+    /// the source writes) in 2D. Always set after [`Scene::resolve`].
+    #[serde(default)]
+    pub softening_stress: Option<SofteningStress>,
     /// The strain initiation and yield read (docs/model.md §7): default the neighbourhood mean
     /// (S.16) on random particles, each particle's own strain on the lattices. Always set
     /// after [`Scene::resolve`].
@@ -360,9 +362,6 @@ fn default_wc_max() -> f64 {
 }
 fn default_initiation() -> Initiation {
     Initiation::Rankine
-}
-fn default_crack_opening() -> CrackOpening {
-    CrackOpening::Total
 }
 
 /// A named set of particles, with its supports and displacement loading.
