@@ -86,7 +86,7 @@ impl ConcreteLaw {
         let c = scene.concrete.as_ref()?;
         let get = |k: &str| scene.derived_value(k).unwrap_or(f64::NAN);
         let cod_c = get("COD_c");
-        let reading = scene.law_reading()?;
+        let (softening_stress, crack_opening) = scene.law_reading()?;
         Some(ConcreteLaw {
             e: scene.material.youngs_modulus(),
             nu: scene.material.nu,
@@ -103,8 +103,8 @@ impl ConcreteLaw {
             wt_cr: c.wt_cr,
             wc_max: c.wc_max,
             initiation: c.initiation,
-            crack_opening: reading.1,
-            softening_stress: reading.0,
+            crack_opening,
+            softening_stress,
             tensile_damage: c.tensile_damage,
             compressive_damage: c.compressive_damage,
             plasticity: c.plasticity,

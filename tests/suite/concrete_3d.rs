@@ -320,8 +320,9 @@ fn fcc_plastic_flow_is_a_plastic_strain_on_both_bond_families() {
 /// The acceptance for 3D concrete on the shipped tension prism (150 × 150 × 300 mm,
 /// Table 1 concrete) at L0 = 15 mm: the peak within ±5% of f't·A, the dissipated energy
 /// within ±10% of G_f·A (the FCC crack band is calibrated on this prism at 10 and 15 mm,
-/// benchmarks/RESULTS.md "The effective stress as the 3D default"), kinetic/internal energy ≤ 5% up to the peak, and
-/// one crack normal to the load across the whole section, in the middle 60% of the height.
+/// benchmarks/RESULTS.md "The effective stress as the 3D default"), kinetic/internal energy
+/// ≤ 5% up to the peak, and one crack normal to the load across the whole section, in the
+/// middle 60% of the height.
 #[test]
 #[cfg_attr(
     not(feature = "validation"),

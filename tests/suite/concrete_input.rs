@@ -36,6 +36,12 @@ fn scene(overrides: &[&str]) -> Result<Scene, String> {
     scene_of(CONCRETE, overrides)
 }
 
+/// The shipped 3D tension prism (FCC) with `overrides`.
+fn prism(overrides: &[&str]) -> Scene {
+    let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
+    scene_of(&text, overrides).unwrap()
+}
+
 fn scene_of(text: &str, overrides: &[&str]) -> Result<Scene, String> {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     Scene::from_toml_str(text, &o).map_err(|e| e.to_string())
@@ -228,8 +234,6 @@ fn crack_band_defaults_by_discretisation() {
         .derived
         .iter()
         .any(|d| d.key == "concrete.crack_band" && d.source == "scene"));
-    let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
-    let prism = |o: &[&str]| scene_of(&text, o).unwrap();
     assert_eq!(band(&prism(&[])), 3.45);
     let random3 = prism(&["discretisation.lattice=\"random\""]);
     assert_eq!(band(&random3), 4.2);
@@ -257,8 +261,6 @@ fn law_reading_defaults_by_dimension() {
     assert_eq!(reading(&scene(&[]).unwrap()), as_written);
     let random = scene(&["discretisation.lattice=\"random\""]).unwrap();
     assert_eq!(reading(&random), as_written);
-    let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
-    let prism = |o: &[&str]| scene_of(&text, o).unwrap();
     assert_eq!(reading(&prism(&[])), effective);
     assert_eq!(
         reading(&prism(&["discretisation.lattice=\"random\""])),
@@ -295,8 +297,6 @@ fn criteria_strain_defaults_by_discretisation() {
     assert_eq!(criteria(&given), Neighbourhood);
     let surface = scene(&["concrete.criteria_strain=\"surface\""]).unwrap();
     assert_eq!(criteria(&surface), sppm::scene::CriteriaStrain::Surface);
-    let text = std::fs::read_to_string("lattices/tension_prism_3d.toml").unwrap();
-    let prism = |o: &[&str]| scene_of(&text, o).unwrap();
     assert_eq!(criteria(&prism(&[])), Own);
     assert_eq!(
         criteria(&prism(&["concrete.criteria_strain=\"neighbourhood\""])),
