@@ -392,7 +392,14 @@ pub fn volume_in_section(cell: &ConvexPolyhedron, section: &Shape2, tol: f64) ->
     zs.windows(2)
         .map(|w| {
             let whole = gauss5(&area, w[0], w[1]);
-            adaptive(&area, (w[0], w[1]), whole, tol / parts, 40, f64::INFINITY)
+            adaptive(
+                &area,
+                (w[0], w[1]),
+                whole,
+                tol / parts,
+                MAX_DEPTH,
+                f64::INFINITY,
+            )
         })
         .sum()
 }
@@ -412,13 +419,16 @@ fn gauss5(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     h * (w0 * f(m) + w1 * (f(m - h * x1) + f(m + h * x1)) + w2 * (f(m - h * x2) + f(m + h * x2)))
 }
 
+/// The depth [`adaptive`] starts from: it splits an interval at most this many times.
+const MAX_DEPTH: u32 = 40;
+
 /// [`adaptive`] accepts no level before it has split each interval twice (the depth falls
-/// from 40): the halves of an interval with a kink inside (where a slice's corner crosses the
-/// section's outline) can agree with the whole by chance. Measured on the test bodies
-/// (`clipped_cells_sum_to_cylinders_and_prisms`), the volumes' sum missed the body's by up
-/// to 1.9e-9 accepting any level, 1.3e-9 after one split, 8e-12 after two (2.7 s for the
-/// eight bodies), 2e-13 after four (13 s).
-const MIN_SPLIT: u32 = 38;
+/// from [`MAX_DEPTH`]): the halves of an interval with a kink inside (where a slice's corner
+/// crosses the section's outline) can agree with the whole by chance. Measured on the test
+/// bodies (`clipped_cells_sum_to_cylinders_and_prisms`), the volumes' sum missed the body's
+/// by up to 1.9e-9 accepting any level, 1.3e-9 after one split, 8e-12 after two (2.7 s for
+/// the eight bodies), 2e-13 after four (13 s).
+const MIN_SPLIT: u32 = MAX_DEPTH - 2;
 
 /// Below this depth (ten splits) [`adaptive`] also accepts a level whose disagreement fell by
 /// less than a quarter from its parent's: the error of a smooth integrand falls by about 2^10
@@ -426,7 +436,7 @@ const MIN_SPLIT: u32 = 38;
 /// 1e-13 m wide by a cell's vertex, in a random particle set of the half-notched beam) falls
 /// only as the interval, as the tolerance does, and kept every branch splitting to the depth
 /// limit: that set's volumes never finished, and now take 4 s.
-const STALL_DEPTH: u32 = 30;
+const STALL_DEPTH: u32 = MAX_DEPTH - 10;
 
 /// [`gauss5`] on halves of [a, b] until the halves agree with the whole to `tol`, or (below
 /// [`STALL_DEPTH`]) their disagreement stalls against `parent`'s, the disagreement one level
@@ -619,7 +629,7 @@ mod tests {
         // tolerance alone would split every branch to 2^40 intervals)
         let noisy = |z: f64| 1.0 + 1e-7 * ((z * 1e9).sin() * 1e4).fract();
         let whole = gauss5(&noisy, 0.0, 1.0);
-        let v = adaptive(&noisy, (0.0, 1.0), whole, 1e-15, 40, f64::INFINITY);
+        let v = adaptive(&noisy, (0.0, 1.0), whole, 1e-15, MAX_DEPTH, f64::INFINITY);
         assert!((v - 1.0).abs() <= 2e-7, "{v}");
         // the volume within a section that cuts the cube in half along x + y = 1
         let half = Shape2::Polygon {
